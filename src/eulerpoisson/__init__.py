@@ -1,0 +1,34 @@
+"""eulerpoisson: the free rigid body in the paper's rotation vector n = k tan(alpha/2).
+
+Attitude sets centred on the Gibbs vector, the rigid-body model, the paper's
+formulations and its machine-checked audit, the exact (elliptic-function)
+motion, and geometric integrators.
+"""
+
+from importlib.metadata import PackageNotFoundError, version as _version
+
+try:
+    __version__ = _version("eulerpoisson")
+except PackageNotFoundError:  # pragma: no cover - running from a source tree
+    __version__ = "0+unknown"
+
+from .attitude import Attitude
+from .body import RigidBody
+from .errors import (
+    EulerPoissonError,
+    InvalidInertiaError,
+    InvalidInputError,
+    MissingDependencyError,
+    SingularChartError,
+)
+
+__all__ = [
+    "__version__",
+    "Attitude",
+    "RigidBody",
+    "EulerPoissonError",
+    "InvalidInputError",
+    "InvalidInertiaError",
+    "SingularChartError",
+    "MissingDependencyError",
+]

@@ -1,0 +1,86 @@
+"""Input validation shared by the package (private)."""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from .errors import InvalidInputError
+
+
+def _describe(x) -> str:
+    a = np.asarray(x)
+    if a.size <= 6:
+        return repr(a.tolist()) if a.ndim else repr(a.item())
+    return f"array of shape {a.shape}"
+
+
+def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite: bool = False) -> np.ndarray:
+    """Return ``x`` as a float64 array whose trailing shape is ``tail``.
+
+    Parameters
+    ----------
+    x : array_like
+        The value to convert.
+    name : str
+        Argument name used in error messages.
+    tail : tuple of int
+        Required trailing dimensions, e.g. ``(3,)`` or ``(3, 3)``.
+    allow_nonfinite : bool
+        Accept NaN and inf (default: reject them).
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not numeric (strings, objects, complex numbers).
+    InvalidInputError
+        If the trailing shape is wrong or a value is NaN or infinite.
+    """
+    if isinstance(x, (str, bytes)):
+        raise TypeError(f"{name} must be numeric, got the string {x!r}")
+    try:
+        a = np.asarray(x)
+    except Exception as exc:  # ragged lists etc.
+        raise InvalidInputError(f"{name} could not be converted to an array: {exc}") from exc
+    if a.dtype == object or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
+        raise TypeError(f"{name} must be a real numeric array, got dtype {a.dtype}")
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real, got complex dtype {a.dtype}")
+    a = a.astype(np.float64, copy=False)
+    nt = len(tail)
+    if nt and (a.ndim < nt or a.shape[a.ndim - nt:] != tuple(tail)):
+        want = "(..., " + ", ".join(str(t) for t in tail) + ")"
+        raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
+    if not allow_nonfinite and not np.all(np.isfinite(a)):
+        raise InvalidInputError(f"{name} contains NaN or infinite values: {_describe(a)}")
+    return a
+
+
+def as_scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, integer: bool = False) -> float:
+    """Return ``x`` as a finite Python float (or int), with range checks.
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not a real number.
+    InvalidInputError
+        If ``x`` is not finite or out of range.
+    """
+    if isinstance(x, bool) or not isinstance(x, (numbers.Real, np.floating, np.integer)):
+        if isinstance(x, np.ndarray) and x.ndim == 0:
+            x = x.item()
+        else:
+            raise TypeError(f"{name} must be a real number, got {type(x).__name__} {x!r}")
+    v = float(x)
+    if not np.isfinite(v):
+        raise InvalidInputError(f"{name} must be finite, got {v!r}")
+    if integer:
+        if v != int(v):
+            raise InvalidInputError(f"{name} must be an integer, got {x!r}")
+        v = int(v)
+    if positive and not v > 0:
+        raise InvalidInputError(f"{name} must be > 0, got {x!r}")
+    if nonnegative and not v >= 0:
+        raise InvalidInputError(f"{name} must be >= 0, got {x!r}")
+    return v

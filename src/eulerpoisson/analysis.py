@@ -1,0 +1,164 @@
+r"""Quantities of the free motion in closed form: elliptic modulus, periods, flips.
+
+For principal moments :math:`I_1<I_2<I_3`, body angular momentum
+:math:`\mathbf M`, :math:`L^2 = |\mathbf M|^2` and :math:`2E = \mathbf M\cdot I^{-1}\mathbf M`,
+the body momentum moves on the polhode with the Jacobi parameter and rate
+
+.. math::
+    k^2 = \frac{(I_3-I_2)(L^2-2EI_1)}{(I_2-I_1)(2EI_3-L^2)},\quad
+    \lambda = \sqrt{\frac{(I_2-I_1)(2EI_3-L^2)}{I_1I_2I_3}}
+    \qquad (L^2 < 2EI_2),
+
+and the same with :math:`1\leftrightarrow3` when :math:`L^2 > 2EI_2`
+(Landau-Lifshitz §37). The period of :math:`\mathbf M(t)` is
+:math:`4K(k)/\lambda`; the component that changes sign (the tennis-racket
+flips) does so every :math:`2K(k)/\lambda`. Differences such as
+:math:`2EI_2 - L^2 = \sum_i M_i^2(I_2/I_i - 1)` and
+:math:`1-k^2 = (I_3-I_1)(2EI_2-L^2)/((I_2-I_1)(2EI_3-L^2))` are formed
+without cancellation.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validate import as_float_array
+from .errors import InvalidInputError
+
+__all__ = ["elliptic_parameters", "momentum_period", "tennis_racket_half_period", "flip_times"]
+
+
+def elliptic_parameters(inertia, M0) -> dict:
+    r"""Jacobi parameter :math:`k^2`, its complement :math:`1-k^2` and the rate :math:`\lambda`.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,)
+        Principal moments, distinct.
+    M0 : array_like, shape (3,)
+        Body angular momentum in the principal frame.
+
+    Returns
+    -------
+    dict
+        ``k2``, ``k2c`` (:math:`1-k^2`, accurate near the separatrix),
+        ``lam``, ``axis`` (index, in the given order, of the principal axis
+        the momentum circulates about: the smallest or the largest moment),
+        ``order`` (the permutation sorting the moments).
+
+    Raises
+    ------
+    InvalidInputError
+        Two equal moments (a symmetric body has no elliptic modulus: the
+        motion is a uniform precession), or a momentum exactly on the
+        separatrix or zero.
+    """
+    I = as_float_array(inertia, "inertia", (3,))
+    M = as_float_array(M0, "M0", (3,))
+    if I.ndim != 1 or M.ndim != 1:
+        raise InvalidInputError("elliptic_parameters takes one body: inertia and M0 of shape (3,)")
+    order = np.argsort(I)
+    I1, I2, I3 = I[order]
+    M = M[order]
+    if not (I1 < I2 < I3):
+        raise InvalidInputError(f"elliptic_parameters needs three distinct principal moments, got {I.tolist()}")
+    L2 = float(M @ M)
+    if L2 == 0:
+        raise InvalidInputError("M0 is zero: the body is at rest")
+    I_ = np.array([I1, I2, I3])
+    d2 = float(np.sum(M**2 * (I2 / I_ - 1.0)))  # 2 E I2 - L^2
+    d1 = float(np.sum(M**2 * (1.0 - I1 / I_)))  # L^2 - 2 E I1 >= 0
+    d3 = float(np.sum(M**2 * (I3 / I_ - 1.0)))  # 2 E I3 - L^2 >= 0
+    if d2 == 0:
+        raise InvalidInputError("M0 lies on the separatrix (L^2 = 2 E I2): the period is infinite")
+    if d2 > 0:  # circulation about the axis of smallest moment
+        k2 = (I3 - I2) * d1 / ((I2 - I1) * d3)
+        k2c = (I3 - I1) * d2 / ((I2 - I1) * d3)
+        lam = np.sqrt((I2 - I1) * d3 / (I1 * I2 * I3))
+        axis = int(order[0])
+    else:
+        k2 = (I2 - I1) * d3 / ((I3 - I2) * d1)
+        k2c = (I3 - I1) * (-d2) / ((I3 - I2) * d1)
+        lam = np.sqrt((I3 - I2) * d1 / (I1 * I2 * I3))
+        axis = int(order[2])
+    return {"k2": k2, "k2c": k2c, "lam": float(lam), "axis": axis, "order": order}
+
+
+def momentum_period(inertia, M0) -> float:
+    r"""Period :math:`4K(k)/\lambda` of the body angular momentum :math:`\mathbf M(t)`.
+
+    Raises
+    ------
+    InvalidInputError
+        See :func:`elliptic_parameters`.
+    """
+    from scipy.special import ellipkm1
+
+    p = elliptic_parameters(inertia, M0)
+    return float(4.0 * ellipkm1(p["k2c"]) / p["lam"])
+
+
+def tennis_racket_half_period(inertia, M0) -> float:
+    r"""Time :math:`2K(k)/\lambda` between consecutive flips (sign changes) of the momentum components that change sign."""
+    return 0.5 * momentum_period(inertia, M0)
+
+
+def flip_times(traj, component: int = 1, *, refine: bool = True) -> np.ndarray:
+    r"""Times at which :math:`\Omega_\mathrm{component}(t)` changes sign.
+
+    Sign changes between samples are located by linear interpolation and,
+    for a single body with ``refine=True``, polished by a few secant steps on
+    the closed-form solution (so they are accurate to round-off, not to the
+    sampling step).
+
+    Parameters
+    ----------
+    traj : Trajectory
+        A single-body trajectory with increasing times.
+    component : int
+        Index 0, 1 or 2 of the body-frame component.
+    refine : bool
+        Polish with the exact solution.
+
+    Returns
+    -------
+    ndarray, shape (F,)
+    """
+    if traj.batch_shape:
+        raise InvalidInputError("flip_times takes a single-body trajectory")
+    if component not in (0, 1, 2):
+        raise InvalidInputError(f"component must be 0, 1 or 2, got {component!r}")
+    order = np.argsort(traj.t)
+    t = traj.t[order]
+    w = traj.omega[order, component]
+    idx = np.nonzero(np.sign(w[:-1]) * np.sign(w[1:]) < 0)[0]
+    t0, t1, w0, w1 = t[idx], t[idx + 1], w[idx], w[idx + 1]
+    roots = t0 - w0 * (t1 - t0) / (w1 - w0)
+    if not refine or roots.size == 0:
+        return roots
+    from .solvers import solve
+
+    q0 = traj.quaternion[order[0]]
+    om0 = traj.omega[order[0]]
+    tstart = t[0]
+
+    def f(tt):
+        tr = solve(traj.body, tt - tstart, omega0=om0, attitude0=q0, method="exact")
+        return tr.omega[:, component]
+
+    a, b = t0.copy(), t1.copy()
+    fa, fb = w0.copy(), w1.copy()
+    x = roots.copy()
+    for _ in range(60):  # Illinois-type false position, bracketing kept
+        fx = f(x)
+        left = np.sign(fx) == np.sign(fa)
+        a = np.where(left, x, a)
+        fa = np.where(left, fx, fa * 0.5)
+        b = np.where(left, b, x)
+        fb = np.where(left, fb * 0.5, fx)
+        xn = a - fa * (b - a) / (fb - fa)
+        done = np.all(np.abs(xn - x) <= 4 * np.finfo(float).eps * np.abs(xn))
+        x = xn
+        if done:
+            break
+    return x

@@ -1,0 +1,336 @@
+r"""The result of :func:`~eulerpoisson.solve`: a :class:`Trajectory`.
+
+A trajectory holds the output times, the attitude (unit quaternions with a
+continuous sign) and the body angular velocity of one body or a batch of
+bodies; everything else — rotation matrices, Gibbs vectors, body and spatial
+angular momenta, energy, the drift of the integrals, the motion of the
+particles of a point-mass body (paper eq. 1.2) — is derived from them.
+Trajectories are written to and read from NetCDF with CF-style attributes.
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import datetime, timezone
+
+import numpy as np
+
+from ._io import atomic_path
+from ._validate import as_float_array
+from .attitude import _matrix_from_unit_quaternion, quaternion_make_continuous
+from .body import RigidBody
+from .errors import EulerPoissonError, InvalidInputError, require
+
+__all__ = ["Trajectory", "FORMAT_VERSION"]
+
+#: version of the NetCDF layout written by :meth:`Trajectory.to_netcdf`
+FORMAT_VERSION = 1
+
+CONVENTIONS = (
+    "x_space = R x_body; dR/dt = R [Omega]x with Omega the body angular velocity; "
+    "quaternion scalar first (w, x, y, z), Hamilton product; Gibbs vector n = (x, y, z)/w = k tan(alpha/2); "
+    "M = I Omega (body frame), m = R I Omega (space frame), E = Omega.I Omega/2. "
+    "Units are those of the inputs (any consistent system; SI names are given for orientation)."
+)
+
+
+class Trajectory:
+    r"""Motion of one body or a batch of bodies at a set of output times.
+
+    Parameters
+    ----------
+    t : array_like, shape (T,)
+        Output times.
+    quaternion : array_like, shape (*batch, T, 4)
+        Attitudes (made unit and sign-continuous in time here).
+    omega : array_like, shape (*batch, T, 3)
+        Body angular velocities.
+    body : RigidBody
+    method : str
+        Name of the method that produced it.
+    options : dict, optional
+        The method's options.
+    stats : dict, optional
+        Counters (wall time, steps, ...).
+
+    Attributes
+    ----------
+    t, quaternion, omega, body, method, options, stats
+
+    Notes
+    -----
+    Derived quantities are properties computed on access: :attr:`matrix`,
+    :attr:`gibbs` (NaN where the rotation angle is :math:`\pi`, flagged by
+    :attr:`gibbs_singular`), :attr:`M`, :attr:`m`, :attr:`energy`.
+    """
+
+    def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None):
+        self.t = as_float_array(t, "t")
+        q = as_float_array(quaternion, "quaternion", (4,))
+        self.omega = as_float_array(omega, "omega", (3,))
+        if q.shape[-2:-1] != self.t.shape or self.omega.shape[:-1] != q.shape[:-1]:
+            raise InvalidInputError(
+                f"inconsistent trajectory shapes: t {self.t.shape}, quaternion {q.shape}, omega {self.omega.shape}"
+            )
+        q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+        order = np.argsort(self.t, kind="stable")
+        qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
+        inv = np.empty_like(order)
+        inv[order] = np.arange(order.size)
+        self.quaternion = np.take(qs, inv, axis=-2)
+        self.body = body
+        self.method = method
+        self.options = dict(options or {})
+        self.stats = dict(stats or {})
+
+    # ------------------------------------------------------------------
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        """Shape of the batch of bodies (``()`` for one body)."""
+        return self.quaternion.shape[:-2]
+
+    def __len__(self) -> int:
+        return self.t.shape[0]
+
+    @property
+    def _inertia(self) -> np.ndarray:
+        return self.body.inertia[..., None, :, :]
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """Rotation matrices R(t), (*batch, T, 3, 3)."""
+        return _matrix_from_unit_quaternion(self.quaternion)
+
+    @property
+    def gibbs_singular(self) -> np.ndarray:
+        r"""Boolean mask (*batch, T): rotation angle exactly :math:`\pi`, where the global Gibbs vector is infinite."""
+        return self.quaternion[..., 0] == 0
+
+    @property
+    def gibbs(self) -> np.ndarray:
+        """Global Gibbs vectors n(t) = (x, y, z)/w, (*batch, T, 3); NaN where :attr:`gibbs_singular`."""
+        w = self.quaternion[..., :1]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = self.quaternion[..., 1:] / w
+        return np.where(w == 0, np.nan, n)
+
+    @property
+    def M(self) -> np.ndarray:
+        r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega`, (*batch, T, 3)."""
+        return np.einsum("...ij,...j->...i", self._inertia, self.omega)
+
+    @property
+    def m(self) -> np.ndarray:
+        r"""Spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`, (*batch, T, 3); constant for the free body."""
+        return np.einsum("...ij,...j->...i", self.matrix, self.M)
+
+    @property
+    def energy(self) -> np.ndarray:
+        r"""Kinetic energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega`, (*batch, T)."""
+        return 0.5 * np.sum(self.omega * self.M, -1)
+
+    def drift(self) -> dict[str, np.ndarray]:
+        r"""Relative drift of every integral of motion over the trajectory.
+
+        Relative to the value at the first output time ``t[0]`` (the
+        initial state when ``t[0] = 0``): for the energy
+        :math:`\max_t|E(t)-E_0|/|E_0|`, for :math:`|\mathbf m|` the same, and
+        for each component :math:`\max_t|m_i(t)-m_i(t_0)|/|\mathbf m(t_0)|`.
+        Zero scales (a body at rest) give absolute values.
+
+        Returns
+        -------
+        dict
+            Keys ``"energy"``, ``"m_norm"``, ``"m_x"``, ``"m_y"``, ``"m_z"``,
+            each an array of the batch shape (a float for one body).
+        """
+        E = self.energy
+        m = self.m
+        mn = np.linalg.norm(m, axis=-1)
+
+        def rel(x, ref, scale):
+            s = np.where(scale > 0, scale, 1.0)
+            return np.max(np.abs(x - ref[..., None]), axis=-1) / s
+
+        out = {
+            "energy": rel(E, E[..., 0], np.abs(E[..., 0])),
+            "m_norm": rel(mn, mn[..., 0], mn[..., 0]),
+        }
+        for i, c in enumerate("xyz"):
+            out[f"m_{c}"] = rel(m[..., i], m[..., 0, i], mn[..., 0])
+        return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in out.items()}
+
+    def particles(self, center0=(0.0, 0.0, 0.0), velocity0=(0.0, 0.0, 0.0)) -> np.ndarray:
+        r"""Positions of the body's point masses, :math:`\mathbf y_N(t) = \mathbf C_0 + \mathbf V_0 t + R(t)\mathbf x_N(0)` (paper eq. 1.2).
+
+        Parameters
+        ----------
+        center0 : array_like, shape (3,)
+            Centre of mass at t = 0 (defaults to the body's own centre of mass
+            if it was built with :meth:`RigidBody.from_particles` and
+            ``center0`` is not given).
+        velocity0 : array_like, shape (3,)
+            Velocity of the centre of mass.
+
+        Returns
+        -------
+        ndarray, shape (*batch, T, N, 3)
+
+        Raises
+        ------
+        InvalidInputError
+            If the body was not built from particles.
+        """
+        if self.body.positions is None:
+            raise InvalidInputError(
+                "this trajectory's body has no particles; build it with RigidBody.from_particles(masses, positions)"
+            )
+        C0 = as_float_array(center0, "center0", (3,))
+        V0 = as_float_array(velocity0, "velocity0", (3,))
+        x0 = self.body.positions  # relative to the centre of mass, body frame = space frame at q = 1
+        y = np.einsum("...tij,nj->...tni", self.matrix, x0)
+        return y + C0 + V0 * self.t[:, None, None]
+
+    # ------------------------------------------------------------------
+    def to_xarray(self):
+        """The trajectory as an :class:`xarray.Dataset` with CF-style attributes.
+
+        Batches are flattened to a ``body`` dimension (the batch shape is kept
+        in the ``batch_shape`` attribute).
+
+        Raises
+        ------
+        MissingDependencyError
+            If xarray is not installed (extra ``io``).
+        """
+        from . import __version__
+
+        xr = require("xarray", "io")
+        bshape = self.batch_shape
+        nb = int(np.prod(bshape)) if bshape else 0
+        T = len(self.t)
+
+        def flat(a, tail):
+            return a.reshape((nb,) + a.shape[len(bshape):]) if bshape else a
+
+        bdim = ("body",) if bshape else ()
+        inertia = np.broadcast_to(self.body.inertia, bshape + (3, 3))
+        data = {
+            "quaternion": (bdim + ("time", "quat"), flat(self.quaternion, 2), {
+                "long_name": "attitude quaternion, scalar first (w, x, y, z); x_space = R(q) x_body",
+                "units": "1"}),
+            "omega": (bdim + ("time", "axis"), flat(self.omega, 2), {
+                "long_name": "body angular velocity Omega (body frame)", "units": "rad s-1"}),
+            "M": (bdim + ("time", "axis"), flat(self.M, 2), {
+                "long_name": "body angular momentum M = I Omega (body frame)", "units": "kg m2 s-1"}),
+            "m": (bdim + ("time", "axis"), flat(self.m, 2), {
+                "long_name": "spatial angular momentum m = R I Omega (space frame)", "units": "kg m2 s-1"}),
+            "energy": (bdim + ("time",), flat(self.energy, 1), {
+                "long_name": "kinetic energy E = Omega.I Omega/2", "units": "J"}),
+            "gibbs": (bdim + ("time", "axis"), flat(self.gibbs, 2), {
+                "long_name": "Gibbs rotation vector n = k tan(alpha/2) (paper eq. 1.8); NaN at alpha = pi",
+                "units": "1"}),
+            "inertia": (bdim + ("axis", "axis2"), flat(inertia, 2), {
+                "long_name": "inertia tensor in the body frame", "units": "kg m2"}),
+        }
+        if self.body.positions is not None and not bshape:
+            data["particle_masses"] = (("particle",), self.body.masses, {"long_name": "point masses", "units": "kg"})
+            data["particle_positions"] = (("particle", "axis"), self.body.positions, {
+                "long_name": "particle positions relative to the centre of mass at t = 0 (body frame)",
+                "units": "m"})
+            data["center_of_mass"] = (("axis",), self.body.center_of_mass, {"long_name": "centre of mass", "units": "m"})
+        coords = {
+            "time": ("time", self.t, {"long_name": "time", "units": "s", "standard_name": "time"}),
+            "quat": ("quat", np.array(["w", "x", "y", "z"])),
+            "axis": ("axis", np.array(["x", "y", "z"])),
+            "axis2": ("axis2", np.array(["x", "y", "z"])),
+        }
+        attrs = {
+            "title": f"free rigid body trajectory ({self.method})",
+            "Conventions": "CF-1.10",
+            "eulerpoisson_conventions": CONVENTIONS,
+            "eulerpoisson_format_version": FORMAT_VERSION,
+            "eulerpoisson_version": __version__,
+            "method": self.method,
+            "method_options": json.dumps(self.options, default=float, sort_keys=True),
+            "stats": json.dumps(self.stats, default=float, sort_keys=True),
+            "batch_shape": json.dumps(list(bshape)),
+            "body_name": self.body.name or "",
+            "T": T,
+            "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} written by eulerpoisson {__version__}",
+            "references": "A. A. Deriglazov, Geodesic motion on the symplectic leaf of SO(3) ... (the paper)",
+        }
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def to_netcdf(self, path) -> None:
+        """Write the trajectory to a NetCDF-4 file, atomically (temporary file, then rename).
+
+        Raises
+        ------
+        MissingDependencyError
+            If xarray or h5netcdf is missing (extra ``io``).
+        """
+        ds = self.to_xarray()
+        require("h5netcdf", "io")
+        with atomic_path(path) as tmp:
+            ds.to_netcdf(tmp, engine="h5netcdf")
+
+    @classmethod
+    def from_netcdf(cls, path) -> "Trajectory":
+        """Read a trajectory written by :meth:`to_netcdf`.
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        EulerPoissonError
+            If the file is not an eulerpoisson trajectory, or was written by
+            a newer, unknown format version.
+        """
+        import os
+
+        xr = require("xarray", "io")
+        if not os.path.exists(path):
+            raise FileNotFoundError(f"no such file: {path}")
+        try:
+            ds = xr.load_dataset(path, engine="h5netcdf")
+        except Exception as exc:
+            raise EulerPoissonError(f"{path} is not a readable NetCDF file: {exc}") from exc
+        ver = ds.attrs.get("eulerpoisson_format_version")
+        if ver is None or "quaternion" not in ds or "omega" not in ds:
+            raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory file")
+        if int(ver) > FORMAT_VERSION:
+            raise EulerPoissonError(
+                f"{path} has format version {int(ver)}, newer than this eulerpoisson "
+                f"({FORMAT_VERSION}); upgrade the package"
+            )
+        bshape = tuple(json.loads(ds.attrs.get("batch_shape", "[]")))
+        q = ds["quaternion"].values
+        w = ds["omega"].values
+        inertia = ds["inertia"].values
+        if bshape:
+            q = q.reshape(bshape + q.shape[1:])
+            w = w.reshape(bshape + w.shape[1:])
+            inertia = inertia.reshape(bshape + (3, 3))
+        name = ds.attrs.get("body_name") or None
+        if "particle_masses" in ds:
+            body = RigidBody.from_particles(
+                ds["particle_masses"].values,
+                ds["particle_positions"].values + ds["center_of_mass"].values,
+                name=name,
+            )
+        else:
+            body = RigidBody(inertia, name=name)
+        return cls(
+            t=ds["time"].values,
+            quaternion=q,
+            omega=w,
+            body=body,
+            method=str(ds.attrs.get("method", "")),
+            options=json.loads(ds.attrs.get("method_options", "{}")),
+            stats=json.loads(ds.attrs.get("stats", "{}")),
+        )
+
+    def __repr__(self) -> str:
+        b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
+        return f"Trajectory(method={self.method!r}, T={len(self.t)}, t=[{self.t.min():.6g}, {self.t.max():.6g}]{b})"

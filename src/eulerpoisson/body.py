@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_float_array
+from ._validate import _describe, as_float_array
 from .errors import InvalidInertiaError, InvalidInputError
 
 __all__ = ["RigidBody"]
@@ -24,35 +24,67 @@ __all__ = ["RigidBody"]
 #: to accept the triangle inequality as an equality
 DEGENERACY_RTOL = 1e-12
 
+#: particles whose centred positions have a second singular value below this
+#: fraction of the first are collinear
+COLLINEAR_RTOL = 1e-12
+
+#: relative tolerance of the symmetry check ``max|I - I^T| <= SYMMETRY_RTOL max|I|``
+SYMMETRY_RTOL = 1e-12
+
 
 def _check_tensor(I: np.ndarray, name: str = "inertia") -> None:
     scale = np.max(np.abs(I), axis=(-1, -2), keepdims=True)
     if np.any(scale == 0):
         raise InvalidInertiaError(f"{name} is zero; a rigid body needs a positive-definite inertia tensor")
     asym = np.max(np.abs(I - np.swapaxes(I, -1, -2)) / scale)
-    if asym > 1e-12:
+    if asym > SYMMETRY_RTOL:
         raise InvalidInertiaError(
             f"{name} is not symmetric: max |I - I^T| / max |I| = {asym:.3g}; an inertia tensor must be symmetric"
         )
 
 
-def _check_moments(ev: np.ndarray, name: str = "inertia") -> None:
-    """Positive and triangle inequalities on principal moments (..., 3)."""
+def _check_moments(ev: np.ndarray, name: str = "inertia", triangle: bool = True) -> None:
+    """Positive and (unless ``triangle=False``) triangle inequalities on principal moments (..., 3)."""
     if np.any(ev <= 0):
         bad = ev[np.any(ev <= 0, axis=-1)][0]
         raise InvalidInertiaError(
             f"{name} is not positive definite: principal moments {np.round(bad, 15).tolist()}; "
             "every principal moment must be > 0 (a body needs at least three non-collinear masses)"
         )
+    if not triangle:
+        return
     s = np.sort(ev, axis=-1)
     slack = s[..., 0] + s[..., 1] - s[..., 2]
     tol = DEGENERACY_RTOL * np.sum(s, -1)
     if np.any(slack < -tol):
         bad = s[slack < -tol][0]
         raise InvalidInertiaError(
-            "inertia violates the triangle inequality I1 + I2 >= I3 of a physical body: principal moments "
-            f"{bad.tolist()} have {bad[0]} + {bad[1]} < {bad[2]}"
+            f"{name} violates the triangle inequality I1 + I2 >= I3 of a physical body: principal moments "
+            f"{bad.tolist()} have {bad[0]} + {bad[1]} < {bad[2]} (pass allow_unphysical=True to study "
+            "Euler's equations with such moments anyway)"
         )
+
+
+def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True):
+    _check_moments(a, name, triangle)
+    ev = a.copy()
+    I = ev[..., :, None] * np.eye(3)
+    P = np.broadcast_to(np.eye(3), I.shape).copy()
+    return I, ev, P
+
+
+def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True):
+    _check_tensor(a, name)
+    I = 0.5 * (a + np.swapaxes(a, -1, -2))
+    ev, P = np.linalg.eigh(I)
+    # right-handed principal frame
+    P[..., :, 2] *= np.sign(np.linalg.det(P))[..., None]
+    # diagonal tensors keep their frame and the order of their moments
+    diag = np.all(I - I * np.eye(3) == 0, axis=(-1, -2))
+    ev = np.where(diag[..., None], np.diagonal(I, axis1=-2, axis2=-1), ev)
+    P = np.where(diag[..., None, None], np.eye(3), P)
+    _check_moments(ev, name, triangle)
+    return I, ev, P
 
 
 class RigidBody:
@@ -63,9 +95,15 @@ class RigidBody:
     inertia : array_like, shape (..., 3) or (..., 3, 3)
         Three principal moments :math:`(I_1, I_2, I_3)` (the body frame is then
         the principal frame) or a full symmetric positive-definite tensor.
-        Leading axes make a batch of bodies.
-    name : str, optional
+        Leading axes make a batch of bodies. An array whose last two axes
+        are (3, 3) is always read as tensors, never as a batch of moments
+        whose batch shape ends in 3: use :meth:`from_moments` for those.
+    name : str, optional, keyword-only
         A label used in plots and files.
+    allow_unphysical : bool, keyword-only
+        Accept positive moments that violate the triangle inequality (no mass
+        distribution has them, but Euler's equations are well defined; e.g.
+        the often-quoted "tennis racket" moments (3, 5, 9)). Default False.
 
     Attributes
     ----------
@@ -75,7 +113,12 @@ class RigidBody:
         Eigenvalues of ``inertia``; in the given order for diagonal input,
         ascending otherwise.
     principal_axes : ndarray, shape (..., 3, 3)
-        Right-handed orthonormal columns: ``inertia = P diag(moments) P^T``.
+        Right-handed orthonormal columns (``det P = +1``):
+        ``inertia = P diag(moments) P^T``.
+    masses, positions, center_of_mass : ndarray or None
+        Set by :meth:`from_particles`: the masses (N,), the positions
+        relative to the centre of mass (N, 3), and the centre of mass (3,).
+    name : str or None
 
     Raises
     ------
@@ -92,6 +135,12 @@ class RigidBody:
     ``"prolate"`` or ``"oblate"``), :attr:`is_sphere` (three equal),
     :attr:`is_planar` (:math:`I_1 + I_2 = I_3`: all mass in a plane).
 
+    See Also
+    --------
+    RigidBody.from_moments : unambiguous construction from principal moments.
+    RigidBody.from_particles : a body of point masses (paper eq. 1.1).
+    RigidBody.in_principal_frame : the same body with a diagonal tensor.
+
     References
     ----------
     Paper eq. 1.5 (Euler's equations use this tensor) and 1.25.
@@ -105,29 +154,21 @@ class RigidBody:
     'oblate'
     """
 
-    def __init__(self, inertia, *, name: str | None = None):
+    def __init__(self, inertia, *, name: str | None = None, allow_unphysical: bool = False):
         a = as_float_array(inertia, "inertia")
+        triangle = not allow_unphysical
         if a.ndim >= 2 and a.shape[-2:] == (3, 3):
-            _check_tensor(a)
-            I = 0.5 * (a + np.swapaxes(a, -1, -2))
-            offdiag = I - I * np.eye(3)
-            if np.all(offdiag == 0):
-                ev = np.diagonal(I, axis1=-2, axis2=-1).copy()
-                P = np.broadcast_to(np.eye(3), I.shape).copy()
-            else:
-                ev, P = np.linalg.eigh(I)
-                det = np.linalg.det(P)
-                P[..., :, 2] *= np.sign(det)[..., None]
+            I, ev, P = _principal_from_tensor(a, "inertia", triangle)
         elif a.ndim >= 1 and a.shape[-1] == 3:
-            ev = a.copy()
-            I = ev[..., :, None] * np.eye(3)
-            P = np.broadcast_to(np.eye(3), I.shape).copy()
+            I, ev, P = _principal_from_moments(a, "inertia", triangle)
         else:
             raise InvalidInputError(
                 f"inertia must be three principal moments, shape (..., 3), or a 3x3 tensor, "
                 f"shape (..., 3, 3); got shape {a.shape}"
             )
-        _check_moments(ev)
+        self._set(I, ev, P, name)
+
+    def _set(self, I, ev, P, name):
         self.inertia = I
         self.principal_moments = ev
         self.principal_axes = P
@@ -135,6 +176,36 @@ class RigidBody:
         self.masses: np.ndarray | None = None
         self.positions: np.ndarray | None = None
         self.center_of_mass: np.ndarray | None = None
+
+    @classmethod
+    def from_moments(cls, moments, *, name: str | None = None, allow_unphysical: bool = False) -> "RigidBody":
+        """A body (or batch) given by principal moments only, shape (..., 3).
+
+        Unambiguous where ``RigidBody(moments)`` is not: a batch of moments of
+        shape ``(..., 3, 3)`` (batch shape ending in 3) would be read as
+        tensors by the constructor.
+
+        Parameters
+        ----------
+        moments : array_like, shape (..., 3)
+            Principal moments; the body frame is the principal frame.
+        name : str, optional, keyword-only
+
+        Returns
+        -------
+        RigidBody
+
+        Raises
+        ------
+        InvalidInertiaError
+            A moment <= 0 or a violated triangle inequality.
+        InvalidInputError
+            Wrong shape, NaN or infinite entries.
+        """
+        a = as_float_array(moments, "moments", (3,))
+        body = cls.__new__(cls)
+        body._set(*_principal_from_moments(a, "moments", not allow_unphysical), name)
+        return body
 
     # ------------------------------------------------------------------
     @classmethod
@@ -174,19 +245,20 @@ class RigidBody:
             raise InvalidInputError(
                 f"masses must have shape (N,) and positions (N, 3) with the same N; got {m.shape} and {x.shape}"
             )
-        if np.any(m <= 0):
-            raise InvalidInputError(f"masses must all be > 0, got {m.tolist()}")
         if m.shape[0] < 3:
             raise InvalidInputError(
                 f"a rigid body needs at least three non-collinear masses, got {m.shape[0]}"
             )
+        if np.any(m <= 0):
+            raise InvalidInputError(f"masses must all be > 0, got {_describe(m)}")
         c = (m[:, None] * x).sum(0) / m.sum()
         xr = x - c
         scale = np.max(np.abs(xr))
         sv = np.linalg.svd(xr / (scale if scale > 0 else 1.0), compute_uv=False)
-        if scale == 0 or sv[1] <= 1e-12 * sv[0]:
+        if scale == 0 or sv[1] <= COLLINEAR_RTOL * sv[0]:
             raise InvalidInputError(
-                "the masses are collinear (or coincide): a rigid body needs at least three non-collinear masses"
+                f"the {m.shape[0]} masses are collinear (or coincide): a rigid body needs at least three "
+                "non-collinear masses (its inertia tensor would be singular)"
             )
         g = np.einsum("n,ni,nj->ij", m, xr, xr)
         I = np.trace(g) * np.eye(3) - g
@@ -194,6 +266,26 @@ class RigidBody:
         body.masses = m
         body.positions = xr
         body.center_of_mass = c
+        return body
+
+    def in_principal_frame(self) -> "RigidBody":
+        r"""The same body described in its principal frame.
+
+        Returns a body whose inertia tensor is ``diag(principal_moments)``;
+        for a body made of particles the positions are rotated into the
+        principal frame, :math:`\mathbf x' = P^T\mathbf x`, and the centre
+        of mass is kept.
+
+        Returns
+        -------
+        RigidBody
+            Diagonal, same batch shape.
+        """
+        body = RigidBody.from_moments(self.principal_moments, name=self.name)
+        if self.positions is not None:
+            body.masses = self.masses
+            body.positions = self.positions @ self.principal_axes
+            body.center_of_mass = self.center_of_mass
         return body
 
     # ------------------------------------------------------------------
@@ -204,13 +296,18 @@ class RigidBody:
 
     @property
     def inertia_inv(self) -> np.ndarray:
-        """Inverse inertia tensor, (..., 3, 3)."""
+        r"""Inverse inertia tensor :math:`I^{-1} = P\,\mathrm{diag}(1/I_k)P^T`, shape (..., 3, 3)."""
         P = self.principal_axes
         return P @ ((1.0 / self.principal_moments)[..., :, None] * np.swapaxes(P, -1, -2))
 
     @property
     def mass_matrix(self) -> np.ndarray:
-        r"""The paper's :math:`g = \tfrac12\mathrm{tr}(I)\mathbf 1 - I` (inverse of :math:`I = \mathrm{tr}(g)\mathbf 1 - g`, eq. 1.3)."""
+        r"""The paper's mass matrix :math:`g_{ij} = \sum_N m_N x^i_N x^j_N`, shape (..., 3, 3).
+
+        Obtained from the inertia tensor by inverting :math:`I = \mathrm{tr}(g)\mathbf 1 - g`:
+        :math:`g = \tfrac12\mathrm{tr}(I)\mathbf 1 - I` (eq. 1.3 uses :math:`g`). Positive
+        semi-definite exactly when the triangle inequalities hold; singular for a planar body.
+        """
         tr = np.trace(self.inertia, axis1=-2, axis2=-1)
         return 0.5 * tr[..., None, None] * np.eye(3) - self.inertia
 
@@ -218,32 +315,47 @@ class RigidBody:
         s = np.sum(np.abs(self.principal_moments), -1)
         return np.abs(a - b) <= DEGENERACY_RTOL * s
 
+    @staticmethod
+    def _flag(x):
+        x = np.asarray(x)
+        return bool(x) if x.ndim == 0 else x
+
     @property
     def is_sphere(self):
-        """All three principal moments equal (within ``DEGENERACY_RTOL``)."""
+        """All three principal moments equal (within ``DEGENERACY_RTOL``).
+
+        A bool for one body, a boolean array of the batch shape otherwise.
+        """
         I = self.principal_moments
-        return self._rel_close(I[..., 0], I[..., 1]) & self._rel_close(I[..., 1], I[..., 2])
+        return self._flag(self._rel_close(I[..., 0], I[..., 1]) & self._rel_close(I[..., 1], I[..., 2]))
 
     @property
     def is_symmetric(self):
-        """At least two principal moments equal: a symmetric top (or a sphere)."""
+        """At least two principal moments equal: a symmetric top (or a sphere).
+
+        A bool for one body, a boolean array of the batch shape otherwise.
+        """
         I = np.sort(self.principal_moments, -1)
-        return self._rel_close(I[..., 0], I[..., 1]) | self._rel_close(I[..., 1], I[..., 2])
+        return self._flag(self._rel_close(I[..., 0], I[..., 1]) | self._rel_close(I[..., 1], I[..., 2]))
 
     @property
     def is_planar(self):
-        """Triangle inequality is an equality, I1 + I2 = I3: a flat body."""
+        """The triangle inequality is an equality, ``I1 + I2 = I3``: all mass in one plane.
+
+        A bool for one body, a boolean array of the batch shape otherwise.
+        """
         I = np.sort(self.principal_moments, -1)
-        return self._rel_close(I[..., 0] + I[..., 1], I[..., 2])
+        return self._flag(self._rel_close(I[..., 0] + I[..., 1], I[..., 2]))
 
     @property
     def is_diagonal(self) -> bool:
-        """The body frame is a principal frame (the tensor is diagonal)."""
+        """The body frame is a principal frame (every tensor of the batch is diagonal)."""
         return bool(np.all(self.inertia - self.inertia * np.eye(3) == 0))
 
     @property
     def kind(self):
-        """``'sphere'``, ``'prolate'`` (rod-like, unique moment smallest), ``'oblate'`` (disk-like) or ``'asymmetric'``.
+        """``'sphere'``, ``'prolate'`` (rod-like: the unique moment is the smallest),
+        ``'oblate'`` (disk-like: the unique moment is the largest) or ``'asymmetric'``.
 
         A string for one body, an array of strings for a batch.
         """
@@ -255,34 +367,117 @@ class RigidBody:
 
     # ------------------------------------------------------------------
     def angular_momentum(self, omega) -> np.ndarray:
-        r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega` (eq. 1.24)."""
+        r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega` (eq. 1.24).
+
+        Parameters
+        ----------
+        omega : array_like, shape (..., 3)
+            Body angular velocity; broadcast against the batch shape.
+
+        Returns
+        -------
+        ndarray, shape (..., 3)
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong shape or non-finite values.
+        """
         w = as_float_array(omega, "omega", (3,))
         return np.einsum("...ij,...j->...i", self.inertia, w)
 
     def angular_velocity(self, M) -> np.ndarray:
-        r"""Body angular velocity :math:`\boldsymbol\Omega = I^{-1}\mathbf M` (eq. 1.24)."""
+        r"""Body angular velocity :math:`\boldsymbol\Omega = I^{-1}\mathbf M` (eq. 1.24).
+
+        Parameters
+        ----------
+        M : array_like, shape (..., 3)
+            Body angular momentum; broadcast against the batch shape.
+
+        Returns
+        -------
+        ndarray, shape (..., 3)
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong shape or non-finite values.
+        """
         M = as_float_array(M, "M", (3,))
         return np.einsum("...ij,...j->...i", self.inertia_inv, M)
 
     def energy(self, omega) -> np.ndarray:
-        r"""Kinetic energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega` (eq. 1.25)."""
+        r"""Kinetic energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega` (eq. 1.25).
+
+        Parameters
+        ----------
+        omega : array_like, shape (..., 3)
+            Body angular velocity; broadcast against the batch shape.
+
+        Returns
+        -------
+        ndarray, shape (...)
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong shape or non-finite values.
+        """
         w = as_float_array(omega, "omega", (3,))
         return 0.5 * np.sum(w * self.angular_momentum(w), -1)
 
     def to_principal(self, v) -> np.ndarray:
-        """Components of body-frame vectors (..., 3) in the principal frame: ``P^T v``."""
+        """Components of body-frame vectors in the principal frame: ``P^T v``.
+
+        Parameters
+        ----------
+        v : array_like, shape (..., 3)
+
+        Returns
+        -------
+        ndarray, shape (..., 3)
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong shape or non-finite values.
+        """
         v = as_float_array(v, "v", (3,))
         return np.einsum("...ji,...j->...i", self.principal_axes, v)
 
     def from_principal(self, v) -> np.ndarray:
-        """Body-frame components of principal-frame vectors: ``P v``."""
+        """Body-frame components of principal-frame vectors: ``P v``.
+
+        Parameters
+        ----------
+        v : array_like, shape (..., 3)
+
+        Returns
+        -------
+        ndarray, shape (..., 3)
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong shape or non-finite values.
+        """
         v = as_float_array(v, "v", (3,))
         return np.einsum("...ij,...j->...i", self.principal_axes, v)
 
     def __getitem__(self, idx) -> "RigidBody":
+        """Bodies of the batch (indexes the batch axes only, never the tensor axes)."""
         if self.batch_shape == ():
             raise TypeError("a single RigidBody cannot be indexed")
-        return RigidBody(self.inertia[idx], name=self.name)
+        shape = self.batch_shape
+        pos = np.arange(int(np.prod(shape))).reshape(shape)[idx]
+        body = RigidBody.__new__(RigidBody)
+        body._set(
+            self.inertia.reshape(-1, 3, 3)[pos],
+            self.principal_moments.reshape(-1, 3)[pos],
+            self.principal_axes.reshape(-1, 3, 3)[pos],
+            self.name,
+        )
+        return body
 
     def __repr__(self) -> str:
         if self.batch_shape == ():

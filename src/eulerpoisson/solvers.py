@@ -145,6 +145,10 @@ class Method:
     def validate(self) -> None:
         """Check ``self.config``; override to validate option values."""
 
+    def nominal_order(self) -> int | None:
+        """Nominal order of this configured instance (may depend on options such as ``scheme``)."""
+        return self.order
+
     def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
         raise NotImplementedError
 

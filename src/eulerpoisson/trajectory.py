@@ -320,7 +320,7 @@ class Trajectory:
                 name=name,
             )
         else:
-            body = RigidBody(inertia, name=name)
+            body = RigidBody(inertia, name=name, allow_unphysical=True)
         return cls(
             t=ds["time"].values,
             quaternion=q,

@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 # pytest-xdist workers; 2 cores on CI
 WORKERS ?= auto
 
-.PHONY: demo test bench venv clean
+.PHONY: demo test bench venv clean browser
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -24,7 +24,16 @@ venv: $(VENV)/.installed-test
 demo: $(VENV)/.installed-all
 	$(BIN)/eulerpoisson demo --out out
 
-test: $(VENV)/.installed-test
+# Chromium for the animation's browser test: installed where possible (Debian, as root),
+# otherwise that one test is skipped with its reason.
+browser:
+	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
+	  ( [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
+	    timeout 300 sh -c 'apt-get update -qq >/dev/null 2>&1; DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null 2>&1' && \
+	    echo "installed chromium for the browser test" ) || \
+	  echo "chromium is not available: the browser test will be skipped"
+
+test: $(VENV)/.installed-test browser
 	$(BIN)/python -m pytest -n $(WORKERS) -q
 
 bench: $(VENV)/.installed-test

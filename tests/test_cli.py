@@ -45,7 +45,7 @@ def test_simulate_full_tensor_gibbs_and_m(capsys):
 
 def test_simulate_writes_netcdf_and_info(capsys, tmp_path):
     path = tmp_path / "run.nc"
-    code, out, err = run(capsys, "simulate", "--inertia", "3,5,9", "--omega", "0,0.4,0.001", "--t-end", "20",
+    code, out, err = run(capsys, "simulate", "--inertia", "3,5,8", "--omega", "0,0.4,0.001", "--t-end", "20",
                          "--samples", "50", "--out", str(path))
     assert code == 0, err
     assert path.exists() and "wrote" in out

@@ -106,7 +106,7 @@ def test_batch_equals_single(rng):
     w0 = rng.standard_normal((3, 3))
     q0 = Attitude.random(3, rng=rng).as_quaternion()
     t = np.linspace(-4, 9, 11)
-    batch = solve(RigidBody(inertia), t, omega0=w0, attitude0=q0)
+    batch = solve(RigidBody.from_moments(inertia), t, omega0=w0, attitude0=q0)
     assert batch.quaternion.shape == (3, 11, 4) and batch.omega.shape == (3, 11, 3)
     for i in range(3):
         one = solve(inertia[i], t, omega0=w0[i], attitude0=q0[i])
@@ -190,7 +190,7 @@ def test_netcdf_round_trip(tmp_path, rng):
 
 def test_netcdf_batch_and_particles_round_trip(tmp_path, rng):
     t = np.linspace(0, 2, 5)
-    tr = solve(RigidBody([[1.0, 2.0, 2.5], [2.0, 2.0, 3.0]]), t, omega0=rng.standard_normal((2, 3)))
+    tr = solve(RigidBody.from_moments([[1.0, 2.0, 2.5], [2.0, 2.0, 3.0]]), t, omega0=rng.standard_normal((2, 3)))
     tr.to_netcdf(tmp_path / "b.nc")
     back = Trajectory.from_netcdf(tmp_path / "b.nc")
     assert back.batch_shape == (2,)

@@ -14,6 +14,9 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
 
 from .attitude import Attitude
 from .body import RigidBody
+from .solvers import available_methods, solve
+from .trajectory import Trajectory
+from .formulations import FORMULATIONS, Formulation, formulation
 from .errors import (
     EulerPoissonError,
     InvalidInertiaError,
@@ -26,6 +29,12 @@ __all__ = [
     "__version__",
     "Attitude",
     "RigidBody",
+    "solve",
+    "available_methods",
+    "Trajectory",
+    "formulation",
+    "Formulation",
+    "FORMULATIONS",
     "EulerPoissonError",
     "InvalidInputError",
     "InvalidInertiaError",

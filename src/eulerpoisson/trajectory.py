@@ -72,7 +72,11 @@ class Trajectory:
             raise InvalidInputError(
                 f"inconsistent trajectory shapes: t {self.t.shape}, quaternion {q.shape}, omega {self.omega.shape}"
             )
-        q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+        nrm = np.linalg.norm(q, axis=-1, keepdims=True)
+        if np.any(nrm == 0):
+            raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
+        # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
+        q = np.where(np.abs(nrm - 1.0) > 4 * np.finfo(float).eps, q / nrm, q)
         order = np.argsort(self.t, kind="stable")
         qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
         inv = np.empty_like(order)

@@ -1,0 +1,733 @@
+r"""Taylor-mode recurrences and the stepping loop of the ``taylor`` method (private).
+
+Two implementations of the same algorithm live here:
+
+* compiled kernels (numba, ``@njit(cache=True)``, scalar loops over fixed-size
+  arrays, one body after the other so that every body has its own steps);
+* a generic NumPy path, vectorized over the bodies, that only uses ``+ - * /``
+  (dividing by integers), comparisons and one square root per chart change
+  on the coefficient arrays, so that it runs unchanged with ``float64``,
+  ``numpy.longdouble`` or ``object`` arrays of ``mpmath.mpf``. Step sizes are
+  chosen in float64 in every arithmetic (a float64 step is exact in the
+  others).
+
+The compiled kernels are used when numba imports and the environment variable
+``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
+module); otherwise the NumPy path runs. Both take the same steps and give the
+same results to round-off: the compiled kernels let LLVM fuse multiply-adds
+(``fastmath={"contract"}`` only, no reassociation) and sum the Cauchy
+products in a different order.
+
+The recurrences (principal frame, :math:`a_1 = (I_2-I_3)/I_1` and cyclic) are
+the Taylor coefficients of the solution of the paper's eq. 1.30,
+
+.. math::
+
+    \dot{\mathbf n} = \tfrac12\big(\boldsymbol\Omega + \mathbf n\times\boldsymbol\Omega
+                      + (\mathbf n\cdot\boldsymbol\Omega)\,\mathbf n\big), \qquad
+    \dot\Omega_1 = a_1\Omega_2\Omega_3 \;(\text{cyclic}),
+
+obtained with Cauchy products: with :math:`x(t) = \sum_k x_k t^k`,
+:math:`(xy)_k = \sum_{j=0}^k x_j y_{k-j}` and :math:`x_{k+1} = f_k/(k+1)`,
+so order :math:`p` costs :math:`O(p^2)` per step (about 15 multiply-adds per
+term of the Cauchy sums).
+
+References
+----------
+A. Jorba and M. Zou, "A software package for the numerical integration of
+ODEs by means of high-order Taylor methods", Exp. Math. 14 (2005) 99-117.
+Paper eq. 1.16, 1.23.1, 1.30.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+
+import numpy as np
+
+__all__ = [
+    "USE_NUMBA",
+    "STATUS_OK",
+    "STATUS_MAX_STEPS",
+    "STATUS_NONFINITE",
+    "auto_order",
+    "step_safety",
+    "series_principal",
+    "series_tensor",
+    "series_canonical",
+    "inverse3",
+    "integrate_numpy",
+    "integrate_numba",
+    "coefficients_numba",
+]
+
+STATUS_OK = 0
+STATUS_MAX_STEPS = 1
+STATUS_NONFINITE = 2
+
+
+def _numba_wanted() -> bool:
+    if os.environ.get("EULERPOISSON_NO_NUMBA", "") == "1":
+        return False
+    try:
+        import numba  # noqa: F401
+    except ImportError:  # pragma: no cover - depends on environment
+        return False
+    return True
+
+
+#: True when the compiled kernels are used (numba importable and
+#: ``EULERPOISSON_NO_NUMBA`` not set to ``"1"`` when this module was imported)
+USE_NUMBA = _numba_wanted()
+
+
+def auto_order(tol: float) -> int:
+    r"""Taylor order for a tolerance (Jorba & Zou 2005): :math:`p = \lceil -\tfrac12\ln\varepsilon + 1\rceil`."""
+    return int(math.ceil(-0.5 * math.log(tol) + 1.0))
+
+
+def step_safety(order: int) -> float:
+    r"""Jorba & Zou's step factor :math:`e^{-0.7/(p-1)}`."""
+    return math.exp(-0.7 / (order - 1)) if order > 1 else 0.5
+
+
+# ---------------------------------------------------------------------------
+# generic recurrences (any dtype supporting + - * /): arrays (p+1, 3, *batch)
+# ---------------------------------------------------------------------------
+def series_principal(a, n0, w0, order):
+    r"""Taylor coefficients of eq. 1.30 in the principal frame (generic arithmetic).
+
+    Parameters
+    ----------
+    a : array, shape (3, *batch)
+        Euler coefficients :math:`a_1 = (I_2-I_3)/I_1` and cyclic.
+    n0, w0 : array, shape (3, *batch)
+        Gibbs vector and body angular velocity (principal frame) at the
+        expansion point.
+    order : int
+
+    Returns
+    -------
+    N, W : arrays, shape (order+1, 3, *batch)
+        :math:`\mathbf n(t) = \sum_k N_k t^k`, :math:`\boldsymbol\Omega(t) = \sum_k W_k t^k`.
+    """
+    dtype = np.result_type(a, n0, w0)
+    shape = (order + 1,) + np.shape(n0)
+    N = np.zeros(shape, dtype=dtype)
+    W = np.zeros(shape, dtype=dtype)
+    S = np.zeros((order + 1,) + np.shape(n0)[1:], dtype=dtype)
+    N[0] = n0
+    W[0] = w0
+    for k in range(order):
+        Nk = N[: k + 1]
+        Wr = W[k::-1]
+        Wk = W[: k + 1]
+        nx, ny, nz = Nk[:, 0], Nk[:, 1], Nk[:, 2]
+        wx, wy, wz = Wr[:, 0], Wr[:, 1], Wr[:, 2]
+        S[k] = (nx * wx + ny * wy + nz * wz).sum(0)
+        cx = (ny * wz - nz * wy).sum(0)
+        cy = (nz * wx - nx * wz).sum(0)
+        cz = (nx * wy - ny * wx).sum(0)
+        e0 = (Wk[:, 1] * wz).sum(0)
+        e1 = (Wk[:, 2] * wx).sum(0)
+        e2 = (Wk[:, 0] * wy).sum(0)
+        Sr = S[: k + 1]
+        Nr = N[k::-1]
+        sx = (Sr * Nr[:, 0]).sum(0)
+        sy = (Sr * Nr[:, 1]).sum(0)
+        sz = (Sr * Nr[:, 2]).sum(0)
+        # divide by integers so that the arithmetic stays exact in mpmath
+        N[k + 1, 0] = (W[k, 0] + cx + sx) / (2 * (k + 1))
+        N[k + 1, 1] = (W[k, 1] + cy + sy) / (2 * (k + 1))
+        N[k + 1, 2] = (W[k, 2] + cz + sz) / (2 * (k + 1))
+        W[k + 1, 0] = a[0] * e0 / (k + 1)
+        W[k + 1, 1] = a[1] * e1 / (k + 1)
+        W[k + 1, 2] = a[2] * e2 / (k + 1)
+    return N, W
+
+
+def _cross_series(x, y, k):
+    """k-th coefficient of x(t) x y(t) for series arrays (p+1, 3, ...)."""
+    xs = x[: k + 1]
+    yr = y[k::-1]
+    return np.stack(
+        [
+            (xs[:, 1] * yr[:, 2] - xs[:, 2] * yr[:, 1]).sum(0),
+            (xs[:, 2] * yr[:, 0] - xs[:, 0] * yr[:, 2]).sum(0),
+            (xs[:, 0] * yr[:, 1] - xs[:, 1] * yr[:, 0]).sum(0),
+        ]
+    )
+
+
+def _dot_series(x, y, k):
+    xs = x[: k + 1]
+    yr = y[k::-1]
+    return (xs[:, 0] * yr[:, 0] + xs[:, 1] * yr[:, 1] + xs[:, 2] * yr[:, 2]).sum(0)
+
+
+def _scal_series(s, x, k):
+    """k-th coefficient of s(t) x(t), s scalar series (p+1, ...), x (p+1, 3, ...)."""
+    return (s[: k + 1, None] * x[k::-1]).sum(0)
+
+
+def _matvec(A, v):
+    """A (3, 3, ...) times v (3, ...), generic arithmetic."""
+    return np.stack([A[i, 0] * v[0] + A[i, 1] * v[1] + A[i, 2] * v[2] for i in range(3)])
+
+
+def inverse3(A):
+    """Inverse of 3x3 matrices A (3, 3, ...) by the adjugate (generic arithmetic)."""
+    c = np.empty_like(A)
+    for i in range(3):
+        for j in range(3):
+            i1, i2 = (i + 1) % 3, (i + 2) % 3
+            j1, j2 = (j + 1) % 3, (j + 2) % 3
+            c[j, i] = A[i1, j1] * A[i2, j2] - A[i1, j2] * A[i2, j1]
+    det = A[0, 0] * c[0, 0] + A[0, 1] * c[1, 0] + A[0, 2] * c[2, 0]
+    return c / det
+
+
+def series_tensor(inertia, inertia_inv, n0, w0, order):
+    r"""Taylor coefficients of eq. 1.30 for a full inertia tensor (generic arithmetic).
+
+    :math:`I\dot{\boldsymbol\Omega} = (I\boldsymbol\Omega)\times\boldsymbol\Omega`,
+    i.e. :math:`\boldsymbol\Omega_{k+1} = I^{-1}\sum_j \mathbf M_j\times\boldsymbol\Omega_{k-j}/(k+1)`
+    with :math:`\mathbf M_j = I\boldsymbol\Omega_j`.
+
+    Parameters
+    ----------
+    inertia, inertia_inv : arrays, shape (3, 3, *batch)
+    n0, w0 : arrays, shape (3, *batch)
+    order : int
+
+    Returns
+    -------
+    N, W : arrays, shape (order+1, 3, *batch)
+    """
+    dtype = np.result_type(inertia, inertia_inv, n0, w0)
+    shape = (order + 1,) + np.shape(n0)
+    N = np.zeros(shape, dtype=dtype)
+    W = np.zeros(shape, dtype=dtype)
+    M = np.zeros(shape, dtype=dtype)
+    S = np.zeros((order + 1,) + np.shape(n0)[1:], dtype=dtype)
+    N[0] = n0
+    W[0] = w0
+    M[0] = _matvec(inertia, W[0])
+    for k in range(order):
+        S[k] = _dot_series(N, W, k)
+        c = _cross_series(N, W, k)
+        sn = _scal_series(S, N, k)
+        N[k + 1] = (W[k] + c + sn) / (2 * (k + 1))
+        W[k + 1] = _matvec(inertia_inv, _cross_series(M, W, k)) / (k + 1)
+        M[k + 1] = _matvec(inertia, W[k + 1])
+    return N, W
+
+
+def series_canonical(inertia_inv, n0, pi0, order):
+    r"""Taylor coefficients in the canonical variables :math:`(\mathbf n, \boldsymbol\pi)` (generic arithmetic).
+
+    Hamilton's equations of :math:`H = \tfrac18(\tilde A\boldsymbol\pi)^T I^{-1}\tilde A\boldsymbol\pi`
+    (paper eq. 1.15), with :math:`\mathbf u = \tilde A\boldsymbol\pi = \boldsymbol\pi + (\mathbf n\cdot\boldsymbol\pi)\mathbf n - \mathbf n\times\boldsymbol\pi`
+    and :math:`\mathbf v = I^{-1}\mathbf u`:
+
+    .. math::
+
+        \dot{\mathbf n} = \tfrac14\tilde A^T\mathbf v = \tfrac14\big(\mathbf v + (\mathbf n\cdot\mathbf v)\mathbf n + \mathbf n\times\mathbf v\big),\qquad
+        \dot{\boldsymbol\pi} = -\tfrac14\big((\mathbf n\cdot\boldsymbol\pi)\mathbf v + (\mathbf n\cdot\mathbf v)\boldsymbol\pi + \mathbf v\times\boldsymbol\pi\big).
+
+    (The last term is :math:`-\tfrac14\epsilon_{ijk}\pi_k v_j`; the paper's
+    eq. 1.16 prints :math:`\epsilon_{ijk}n_k` there, which is not
+    :math:`-\partial H/\partial n_i`.)
+
+    Parameters
+    ----------
+    inertia_inv : array, shape (3, 3, *batch)
+    n0, pi0 : arrays, shape (3, *batch)
+    order : int
+
+    Returns
+    -------
+    N, PI : arrays, shape (order+1, 3, *batch)
+    """
+    dtype = np.result_type(inertia_inv, n0, pi0)
+    shape = (order + 1,) + np.shape(n0)
+    N = np.zeros(shape, dtype=dtype)
+    P = np.zeros(shape, dtype=dtype)
+    U = np.zeros(shape, dtype=dtype)
+    V = np.zeros(shape, dtype=dtype)
+    sa = np.zeros((order + 1,) + np.shape(n0)[1:], dtype=dtype)  # n.pi
+    sb = np.zeros_like(sa)  # n.v
+    N[0] = n0
+    P[0] = pi0
+    for k in range(order):
+        sa[k] = _dot_series(N, P, k)
+        U[k] = P[k] + _scal_series(sa, N, k) - _cross_series(N, P, k)
+        V[k] = _matvec(inertia_inv, U[k])
+        sb[k] = _dot_series(N, V, k)
+        ndot = V[k] + _scal_series(sb, N, k) + _cross_series(N, V, k)
+        pdot = _scal_series(sa, V, k) + _scal_series(sb, P, k) + _cross_series(V, P, k)
+        N[k + 1] = ndot / (4 * (k + 1))
+        P[k + 1] = -pdot / (4 * (k + 1))
+    return N, P
+
+
+# ---------------------------------------------------------------------------
+# generic stepping loop (NumPy, vectorized over bodies)
+# ---------------------------------------------------------------------------
+def _sqrt(x):
+    if x.dtype == object:
+        return x ** 0.5
+    return np.sqrt(x)
+
+
+def _qmul_cols(p, q):
+    """Hamilton product of quaternions stored as (4, ...) columns."""
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ]
+    )
+
+
+def _attitude_cols(qr, n):
+    """Unit quaternion q_ref (x) (1, n)/|(1, n)| as (4, ...) columns."""
+    one = np.ones_like(n[0])
+    q = _qmul_cols(qr, np.stack([one, n[0], n[1], n[2]]))
+    return q / _sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+
+
+def _horner(X, theta):
+    """Evaluate series X (p+1, 3, m) at theta (m,)."""
+    acc = X[-1].copy()
+    for k in range(X.shape[0] - 2, -1, -1):
+        acc = acc * theta + X[k]
+    return acc
+
+
+def _to_float(x):
+    return np.asarray(x).astype(np.float64)
+
+
+def _step_sizes(N, W, order, tol, safety, scale_n, scale_w):
+    """Jorba-Zou step from the last two coefficients (float64, one per body)."""
+    rho = np.full(N.shape[-1], np.inf)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        for k in (order - 1, order):
+            if k < 1:
+                continue
+            for X, sc in ((N, scale_n), (W, scale_w)):
+                nrm = _to_float(np.abs(X[k]).max(axis=0))
+                r = np.where(nrm > 0, (tol * sc / np.where(nrm > 0, nrm, 1.0)) ** (1.0 / k), np.inf)
+                rho = np.minimum(rho, np.where(np.isnan(nrm), np.nan, r))
+    return safety * rho
+
+
+def integrate_numpy(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold):
+    r"""Generic (NumPy) Taylor integration of bodies in their principal frames.
+
+    Parameters
+    ----------
+    moments : array, shape (B, 3)
+        Principal moments (float64, longdouble or object/mpmath).
+    w0 : array, shape (B, 3)
+        Initial body angular velocities, principal frame.
+    qref0 : array, shape (B, 4)
+        Initial reference quaternions (the attitude at t = 0).
+    t : array, shape (T,)
+        Output times, any order and sign.
+    tol : float
+        Tolerance (adaptive steps) — ignored when ``dt`` is given.
+    order : int
+        Taylor order.
+    dt : float or None
+        Fixed step size (> 0), or None for adaptive steps.
+    max_steps : int
+        Maximum number of steps per body (both directions together).
+    threshold : float
+        Chart change when :math:`|\mathbf n| >` threshold at the end of a step.
+
+    Returns
+    -------
+    q : array (B, T, 4), w : array (B, T, 3), stats : int64 array (B, 3)
+        stats columns: steps, chart changes, status (0 ok, 1 max_steps, 2 non-finite).
+    """
+    with np.errstate(over="ignore", invalid="ignore"):  # a diverging state is reported in stats
+        return _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold)
+
+
+def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold):
+    moments = np.asarray(moments)
+    w0 = np.asarray(w0)
+    qref0 = np.asarray(qref0)
+    t = np.asarray(t)
+    dtype = np.result_type(moments, w0, qref0, t)
+    B = moments.shape[0]
+    T = t.shape[0]
+    I1, I2, I3 = moments[:, 0], moments[:, 1], moments[:, 2]
+    a = np.stack([(I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3]).astype(dtype)
+    q_out = np.zeros((B, T, 4), dtype=dtype)
+    w_out = np.zeros((B, T, 3), dtype=dtype)
+    stats = np.zeros((B, 3), dtype=np.int64)
+    tf = _to_float(t)
+    safety = step_safety(order)
+    thr2 = threshold * threshold
+    w0c = np.ascontiguousarray(w0.T).astype(dtype)
+    scale_w_all = _to_float(np.abs(w0c).max(axis=0))
+    pos = np.flatnonzero(tf >= 0)
+    pos = pos[np.argsort(tf[pos], kind="stable")]
+    neg = np.flatnonzero(tf < 0)
+    neg = neg[np.argsort(-tf[neg], kind="stable")]
+    for sign, idx in ((1.0, pos), (-1.0, neg)):
+        L = idx.size
+        if L == 0:
+            continue
+        tlast = abs(tf[idx[-1]])
+        tt = t[idx]
+        n = np.zeros((3, B), dtype=dtype)
+        w = w0c.copy()
+        qr = np.ascontiguousarray(qref0.T).astype(dtype)
+        th = np.zeros(B, dtype=dtype)  # current time (Kahan sum of the steps)
+        tc = np.zeros(B, dtype=dtype)  # its compensation
+        ptr = np.zeros(B, dtype=np.int64)
+        live = np.flatnonzero(stats[:, 2] == STATUS_OK)
+        while live.size:
+            N, W = series_principal(a[:, live], n[:, live], w[:, live], order)
+            if dt is None:
+                scale_n = np.maximum(1.0, _to_float(np.abs(n[:, live]).max(axis=0)))
+                h = _step_sizes(N, W, order, tol, safety, scale_n, scale_w_all[live])
+                rem = 2.0 * np.maximum(tlast - np.abs(_to_float(th[live])), 0.0) + 1.0
+                h = np.where(np.isinf(h), rem, h)
+            else:
+                h = np.full(live.size, float(dt))
+            stats[live, 0] += 1
+            bad = ~np.isfinite(h) | ~(h > 0)
+            # outputs inside this step: |t_out - t| <= h
+            while True:
+                pend = ptr[live] < L
+                j = np.minimum(ptr[live], L - 1)
+                theta = (tt[j] - th[live]) + tc[live]
+                inside = pend & ~bad & (_to_float(sign * theta) <= h)
+                if not inside.any():
+                    break
+                sel = live[inside]
+                thi = theta[inside]
+                nv = _horner(N[:, :, inside], thi)
+                wv = _horner(W[:, :, inside], thi)
+                cols = idx[ptr[sel]]
+                q_out[sel, cols] = _attitude_cols(qr[:, sel], nv).T
+                w_out[sel, cols] = wv.T
+                ptr[sel] += 1
+            finished = ptr[live] >= L
+            adv = ~finished & ~bad
+            hs = (sign * h).astype(np.float64)
+            if adv.any():
+                sl = live[adv]
+                hv = hs[adv].astype(dtype)
+                n[:, sl] = _horner(N[:, :, adv], hv)
+                w[:, sl] = _horner(W[:, :, adv], hv)
+                # Kahan summation of the time
+                y = hv - tc[sl]
+                s = th[sl] + y
+                tc[sl] = (s - th[sl]) - y
+                th[sl] = s
+                nn = n[0, sl] * n[0, sl] + n[1, sl] * n[1, sl] + n[2, sl] * n[2, sl]
+                nnf = _to_float(nn)
+                chg = nnf > thr2
+                if chg.any():
+                    sc = sl[chg]
+                    qr[:, sc] = _attitude_cols(qr[:, sc], n[:, sc])
+                    n[:, sc] = 0
+                    stats[sc, 1] += 1
+                nonfinite = ~np.isfinite(nnf) | ~np.isfinite(_to_float(w[:, sl]).sum(0))
+                stats[sl[nonfinite], 2] = STATUS_NONFINITE
+            stats[live[bad], 2] = STATUS_NONFINITE
+            over = adv & (stats[live, 0] >= max_steps) & (stats[live, 2] == STATUS_OK)
+            stats[live[over], 2] = STATUS_MAX_STEPS
+            live = live[adv & (stats[live, 2] == STATUS_OK)]
+    return q_out, w_out, stats
+
+
+# ---------------------------------------------------------------------------
+# compiled kernels
+# ---------------------------------------------------------------------------
+def _nb_series(a0, a1, a2, n0, w0, order, N, W, S):
+    N[0, 0] = n0[0]
+    N[0, 1] = n0[1]
+    N[0, 2] = n0[2]
+    W[0, 0] = w0[0]
+    W[0, 1] = w0[1]
+    W[0, 2] = w0[2]
+    for k in range(order):
+        s = 0.0
+        cx = 0.0
+        cy = 0.0
+        cz = 0.0
+        e0 = 0.0
+        e1 = 0.0
+        e2 = 0.0
+        sx = 0.0
+        sy = 0.0
+        sz = 0.0
+        for j in range(k + 1):
+            m = k - j
+            nx = N[j, 0]
+            ny = N[j, 1]
+            nz = N[j, 2]
+            wx = W[m, 0]
+            wy = W[m, 1]
+            wz = W[m, 2]
+            s += nx * wx + ny * wy + nz * wz
+            cx += ny * wz - nz * wy
+            cy += nz * wx - nx * wz
+            cz += nx * wy - ny * wx
+            e0 += W[j, 1] * wz
+            e1 += W[j, 2] * wx
+            e2 += W[j, 0] * wy
+            if j > 0:
+                sm = S[m]
+                sx += sm * nx
+                sy += sm * ny
+                sz += sm * nz
+        S[k] = s
+        sx += s * N[0, 0]
+        sy += s * N[0, 1]
+        sz += s * N[0, 2]
+        d = 2.0 * (k + 1)
+        e = 1.0 * (k + 1)
+        N[k + 1, 0] = (W[k, 0] + cx + sx) / d
+        N[k + 1, 1] = (W[k, 1] + cy + sy) / d
+        N[k + 1, 2] = (W[k, 2] + cz + sz) / d
+        W[k + 1, 0] = a0 * e0 / e
+        W[k + 1, 1] = a1 * e1 / e
+        W[k + 1, 2] = a2 * e2 / e
+
+
+def _nb_coefficients(moments, n0, w0, order):
+    B = moments.shape[0]
+    N = np.zeros((B, order + 1, 3))
+    W = np.zeros((B, order + 1, 3))
+    S = np.zeros(order + 1)
+    for b in range(B):
+        I1 = moments[b, 0]
+        I2 = moments[b, 1]
+        I3 = moments[b, 2]
+        _nb_series((I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3, n0[b], w0[b], order, N[b], W[b], S)
+    return N, W
+
+
+def _nb_attitude(qr, nx, ny, nz, out):
+    pw = qr[0]
+    px = qr[1]
+    py = qr[2]
+    pz = qr[3]
+    q0 = pw - px * nx - py * ny - pz * nz
+    q1 = pw * nx + px + py * nz - pz * ny
+    q2 = pw * ny - px * nz + py + pz * nx
+    q3 = pw * nz + px * ny - py * nx + pz
+    r = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+    out[0] = q0 / r
+    out[1] = q1 / r
+    out[2] = q2 / r
+    out[3] = q3 / r
+
+
+def _nb_horner(N, W, order, theta, n, w):
+    """n(theta), Omega(theta) from the series; the six Horner chains interleaved."""
+    a0 = N[order, 0]
+    a1 = N[order, 1]
+    a2 = N[order, 2]
+    b0 = W[order, 0]
+    b1 = W[order, 1]
+    b2 = W[order, 2]
+    for k in range(order - 1, -1, -1):
+        a0 = a0 * theta + N[k, 0]
+        a1 = a1 * theta + N[k, 1]
+        a2 = a2 * theta + N[k, 2]
+        b0 = b0 * theta + W[k, 0]
+        b1 = b1 * theta + W[k, 1]
+        b2 = b2 * theta + W[k, 2]
+    n[0] = a0
+    n[1] = a1
+    n[2] = a2
+    w[0] = b0
+    w[1] = b1
+    w[2] = b2
+
+
+def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold, q_out, w_out, stats):
+    B = moments.shape[0]
+    N = np.zeros((order + 1, 3))
+    W = np.zeros((order + 1, 3))
+    S = np.zeros(order + 1)
+    n = np.zeros(3)
+    w = np.zeros(3)
+    qr = np.zeros(4)
+    qtmp = np.zeros(4)
+    nv = np.zeros(3)
+    wv = np.zeros(3)
+    if order > 1:
+        safety = math.exp(-0.7 / (order - 1))
+    else:
+        safety = 0.5
+    thr2 = threshold * threshold
+    for b in range(B):
+        I1 = moments[b, 0]
+        I2 = moments[b, 1]
+        I3 = moments[b, 2]
+        a0 = (I2 - I3) / I1
+        a1 = (I3 - I1) / I2
+        a2 = (I1 - I2) / I3
+        scale_w = max(abs(w0[b, 0]), abs(w0[b, 1]), abs(w0[b, 2]))
+        steps = 0
+        charts = 0
+        status = 0
+        for d in range(2):
+            if d == 0:
+                idx = idx_pos
+                sign = 1.0
+            else:
+                idx = idx_neg
+                sign = -1.0
+            L = idx.shape[0]
+            if L == 0 or status != 0:
+                continue
+            tlast = abs(t[idx[L - 1]])
+            n[0] = 0.0
+            n[1] = 0.0
+            n[2] = 0.0
+            w[0] = w0[b, 0]
+            w[1] = w0[b, 1]
+            w[2] = w0[b, 2]
+            for c in range(4):
+                qr[c] = qref0[b, c]
+            th = 0.0
+            tc = 0.0
+            ptr = 0
+            while True:
+                _nb_series(a0, a1, a2, n, w, order, N, W, S)
+                if dt > 0.0:
+                    h = dt
+                else:
+                    scale_n = max(1.0, abs(n[0]), abs(n[1]), abs(n[2]))
+                    rho = math.inf
+                    nanflag = False
+                    for k in range(order - 1, order + 1):
+                        if k < 1:
+                            continue
+                        x = math.inf
+                        nrm = max(abs(N[k, 0]), abs(N[k, 1]), abs(N[k, 2]))
+                        if nrm != nrm:
+                            nanflag = True
+                        elif nrm > 0.0:
+                            x = tol * scale_n / nrm
+                        nrm = max(abs(W[k, 0]), abs(W[k, 1]), abs(W[k, 2]))
+                        if nrm != nrm:
+                            nanflag = True
+                        elif nrm > 0.0:
+                            x = min(x, tol * scale_w / nrm)
+                        if x < math.inf:
+                            r = x ** (1.0 / k)
+                            if r < rho:
+                                rho = r
+                    h = safety * rho
+                    if nanflag:
+                        h = math.nan
+                    elif math.isinf(h):
+                        h = 2.0 * max(tlast - abs(th), 0.0) + 1.0
+                steps += 1
+                if not (h > 0.0) or math.isinf(h):
+                    status = 2
+                    break
+                # dense output inside the step
+                while ptr < L:
+                    j = idx[ptr]
+                    theta = (t[j] - th) + tc
+                    if sign * theta > h:
+                        break
+                    _nb_horner(N, W, order, theta, nv, wv)
+                    _nb_attitude(qr, nv[0], nv[1], nv[2], qtmp)
+                    for c in range(4):
+                        q_out[b, j, c] = qtmp[c]
+                    for c in range(3):
+                        w_out[b, j, c] = wv[c]
+                    ptr += 1
+                if ptr >= L:
+                    break
+                hs = sign * h
+                _nb_horner(N, W, order, hs, n, w)
+                y = hs - tc
+                s = th + y
+                tc = (s - th) - y
+                th = s
+                nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+                if nn > thr2:
+                    _nb_attitude(qr, n[0], n[1], n[2], qtmp)
+                    for c in range(4):
+                        qr[c] = qtmp[c]
+                    n[0] = 0.0
+                    n[1] = 0.0
+                    n[2] = 0.0
+                    charts += 1
+                if not (math.isfinite(nn) and math.isfinite(w[0] + w[1] + w[2])):
+                    status = 2
+                    break
+                if steps >= max_steps:
+                    status = 1
+                    break
+        stats[b, 0] = steps
+        stats[b, 1] = charts
+        stats[b, 2] = status
+
+
+if USE_NUMBA:  # pragma: no branch
+    from numba import njit as _njit
+
+    _nb_series = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series)
+    _nb_attitude = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_attitude)
+    _nb_horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner)
+    _nb_coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_coefficients)
+    _nb_integrate = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate)
+
+
+def coefficients_numba(moments, n0, w0, order):
+    """Taylor coefficients by the compiled kernel, (B, order+1, 3) each (float64).
+
+    Runs the plain-Python version of the same code when numba is not used.
+    """
+    return _nb_coefficients(
+        np.ascontiguousarray(moments, dtype=np.float64),
+        np.ascontiguousarray(n0, dtype=np.float64),
+        np.ascontiguousarray(w0, dtype=np.float64),
+        int(order),
+    )
+
+
+def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold):
+    """Compiled Taylor integration; same arguments and results as :func:`integrate_numpy` (float64 only).
+
+    Runs the plain-Python version of the same code when numba is not used
+    (slow; :func:`integrate_numpy` is the fallback actually used then).
+    """
+    moments = np.ascontiguousarray(moments, dtype=np.float64)
+    w0 = np.ascontiguousarray(w0, dtype=np.float64)
+    qref0 = np.ascontiguousarray(qref0, dtype=np.float64)
+    t = np.ascontiguousarray(t, dtype=np.float64)
+    B, T = moments.shape[0], t.shape[0]
+    pos = np.flatnonzero(t >= 0)
+    pos = np.ascontiguousarray(pos[np.argsort(t[pos], kind="stable")], dtype=np.int64)
+    neg = np.flatnonzero(t < 0)
+    neg = np.ascontiguousarray(neg[np.argsort(-t[neg], kind="stable")], dtype=np.int64)
+    q_out = np.zeros((B, T, 4))
+    w_out = np.zeros((B, T, 3))
+    stats = np.zeros((B, 3), dtype=np.int64)
+    _nb_integrate(
+        moments, w0, qref0, t, pos, neg, float(tol), int(order), float(dt) if dt is not None else -1.0,
+        int(max_steps), float(threshold), q_out, w_out, stats,
+    )
+    return q_out, w_out, stats

@@ -128,3 +128,40 @@ def test_console_script_entry_point(tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 2
     assert len(res.stderr.strip().splitlines()) == 1
+
+
+def test_sweep_and_atlas_plot(capsys, tmp_path):
+    cfg = tmp_path / "s.toml"
+    cfg.write_text(
+        "[sweep]\nkind = 'grid'\n[inertia]\nI1 = 1.0\nI2 = 2.0\nI3 = 3.0\n"
+        "[momentum]\npolar = {start = 10.0, stop = 170.0, num = 5}\nazimuth = {start = 0.0, stop = 90.0, num = 4}\n"
+        "degrees = true\n[output]\npath = 'x.zarr'\nchunk = 8\n[compute]\nT = 5.0\nscheduler = 'serial'\n"
+    )
+    store = tmp_path / "atlas.zarr"
+    code, out, err = run(capsys, "sweep", str(cfg), "--out", str(store))
+    assert code == 0, err
+    from eulerpoisson.sweep import load_sweep
+
+    ds = load_sweep(store)
+    assert ds["half_period"].size == 20
+    code, out, err = run(capsys, "plot", str(store), "--kind", "atlas", "--out", str(tmp_path / "a.png"))
+    assert code == 0, err
+    assert (tmp_path / "a.png").stat().st_size > 1000
+    code, out, err = run(capsys, "sweep", str(tmp_path / "none.toml"))
+    assert code == 2 and "does not exist" in err
+
+
+def test_simulate_streams_to_zarr(capsys, tmp_path):
+    store = tmp_path / "r.zarr"
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10",
+                         "--samples", "1001", "--out", str(store), "--json")
+    assert code == 0, err
+    import xarray as xr
+
+    ds = xr.open_zarr(store)
+    assert ds["quaternion"].shape == (1001, 4)
+    last = json.loads(out)
+    np.testing.assert_allclose(ds["omega"].values[-1], last["omega"], atol=1e-15)
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
+                         "--out", str(tmp_path / "r.txt"))
+    assert code == 2 and ".nc (NetCDF) or .zarr" in err

@@ -236,11 +236,21 @@ def cmd_simulate(args) -> int:
     if method not in available_methods():
         raise UsageError(f"--method: unknown method {method!r}; available: {', '.join(available_methods())}")
     opts = _method_options(cfg)
-    t = np.linspace(0.0, t_end, samples)
-    traj = solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
     out = cfg.get("output.file")
-    if out:
-        traj.to_netcdf(out)
+    if out and str(out).endswith(".zarr"):
+        # long runs stream to disk chunk by chunk (atomic, resumable); the final state is read back
+        from .stream import solve_to_file
+
+        solve_to_file(body, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
+                      progress=False if (args.quiet or args.json) else None, overwrite=True, **opts)
+        traj = solve(body, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    else:
+        t = np.linspace(0.0, t_end, samples)
+        traj = solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        if out:
+            if not str(out).endswith((".nc", ".nc4", ".netcdf")):
+                raise UsageError(f"--out {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")
+            traj.to_netcdf(out)
     drift = traj.drift()
     if args.json:
         print(json.dumps(_state_json(traj, drift)))
@@ -282,11 +292,18 @@ def _read_traj(path):
 
 
 def cmd_plot(args) -> int:
-    from . import plots
-
-    traj = _read_traj(args.file)
     out = args.out or f"{Path(args.file).stem}_{args.kind}.png"
-    plots.plot(traj, args.kind, out=out)
+    if args.kind == "atlas":
+        from .sweep import load_sweep, plot_atlas
+
+        if not os.path.exists(args.file):
+            raise UsageError(f"{args.file}: no such sweep store (make one with 'eulerpoisson sweep sweep.toml')")
+        plot_atlas(load_sweep(args.file), out)
+    else:
+        from . import plots
+
+        traj = _read_traj(args.file)
+        plots.plot(traj, args.kind, out=out)
     if not args.quiet:
         print(f"wrote {out}")
     return 0
@@ -318,6 +335,24 @@ def cmd_info(args) -> int:
         lines.append(f"  m           {np.round(traj.m[0], 12).tolist()}")
     lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in traj.drift().items()))
     print("\n".join(lines))
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from .sweep import load_config, run_sweep
+
+    if not os.path.exists(args.config):
+        raise UsageError(f"sweep file {args.config!r} does not exist (see examples/sweep.toml)")
+    path = run_sweep(
+        load_config(args.config),
+        path=args.out,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        progress=False if args.quiet else None,
+        overwrite=args.overwrite,
+    )
+    if not args.quiet:
+        print(f"wrote {path}")
     return 0
 
 
@@ -391,8 +426,8 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=ex,
         epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf",
     )
-    pl.add_argument("file", help="trajectory NetCDF file written by 'simulate --out'")
-    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude"])
+    pl.add_argument("file", help="trajectory NetCDF file written by 'simulate --out' (or a sweep store for --kind atlas)")
+    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "atlas"])
     pl.add_argument("--out", help="figure file (.png, .svg or .pdf)")
     pl.add_argument("--quiet", action="store_true")
     pl.set_defaults(func=cmd_plot)
@@ -408,6 +443,25 @@ def build_parser() -> argparse.ArgumentParser:
     an.add_argument("--fps", type=int, default=30)
     an.add_argument("--quiet", action="store_true")
     an.set_defaults(func=cmd_animate)
+
+    sw = sub.add_parser(
+        "sweep",
+        help="a grid or random sweep over inertia ratios and initial states, on Dask, into Zarr",
+        formatter_class=ex,
+        epilog=(
+            "examples:\n  eulerpoisson sweep examples/sweep.toml\n"
+            "  eulerpoisson sweep atlas.toml --scheduler tcp://10.0.0.5:8786 --out atlas.zarr\n"
+            "  eulerpoisson plot atlas.zarr --kind atlas --out atlas.png\n\n"
+            "An interrupted sweep resumes where it stopped when run again."
+        ),
+    )
+    sw.add_argument("config", help="TOML file describing the sweep (see examples/sweep.toml)")
+    sw.add_argument("--out", help="Zarr store (default: [output] path of the file)")
+    sw.add_argument("--scheduler", help="'local' (default, an embedded cluster), 'serial', or tcp://HOST:PORT")
+    sw.add_argument("--workers", type=int, help="workers of the local cluster")
+    sw.add_argument("--overwrite", action="store_true", help="replace a store made with another configuration")
+    sw.add_argument("--quiet", action="store_true")
+    sw.set_defaults(func=cmd_sweep)
 
     i = sub.add_parser("info", help="describe a trajectory file", epilog="example:\n  eulerpoisson info run.nc", formatter_class=ex)
     i.add_argument("file")

@@ -36,7 +36,12 @@ browser:
 test: $(VENV)/.installed-test browser
 	$(BIN)/python -m pytest -n $(WORKERS) -q
 
-bench: $(VENV)/.installed-test
+# optional peers of the benchmark (heyoka, MuJoCo): installed where possible, skipped otherwise
+$(VENV)/.installed-peers: | $(VENV)/.installed-test
+	-$(BIN)/python -m pip install --quiet heyoka mujoco || echo "optional benchmark peers unavailable"
+	@touch $@
+
+bench: $(VENV)/.installed-test $(VENV)/.installed-peers
 	$(BIN)/python benchmarks/run.py
 
 clean:

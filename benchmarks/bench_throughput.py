@@ -1,0 +1,112 @@
+"""Throughput of the batched (vectorized) paths, one thread.
+
+* exact: evaluations per second for B bodies x T output times, attitude and angular velocity
+  included, through ``solve`` and through the kernel ``_exact.exact_motion`` alone;
+* taylor: body-seconds per second (simulated time x bodies / wall time) at tol = eps for a batch
+  of B bodies integrated to t_end, and the same for heyoka's batch (SIMD) mode when installed;
+* symplectic: body-steps per second for a batch of B bodies (splitting, splitting4, gauss4);
+* scipy's ``special.ellipj``: nanoseconds per evaluation, the cost of one Jacobi elliptic
+  function triple, as the yardstick of the exact method.
+
+The bodies: I = diag(1, 2, 3), identity attitude, Omega0 of random direction (fixed seed) with
+the length of the reference Omega0 = (1, 0.1, 0.5), so all regimes of the motion occur.
+
+    .venv/bin/python benchmarks/bench_throughput.py [--quick] [--out DIR]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import _common as C
+
+
+def bodies(n: int, seed: int = 20240601) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    v = rng.standard_normal((n, 3))
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    return v * np.linalg.norm(C.OMEGA0)
+
+
+def run(quick: bool = False, log=print) -> dict:
+    from eulerpoisson._exact import exact_motion
+    from eulerpoisson.solvers import solve
+
+    cfg = {
+        "exact_bodies": 20 if quick else 1000,
+        "exact_times": 20 if quick else 1000,
+        "taylor_bodies": 40 if quick else 10_000,
+        "taylor_t_end": 10.0 if quick else 100.0,
+        "symplectic_bodies": 40 if quick else 10_000,
+        "symplectic_steps": 10 if quick else 100,
+        "symplectic_dt": 0.01,
+        "ellipj_evaluations": 10_000 if quick else 1_000_000,
+    }
+    repeats = 1 if quick else 3
+    I = list(C.INERTIA)
+    out = {"config": cfg, "rows": []}
+
+    def add(name, label, value, unit, **extra):
+        out["rows"].append({"name": name, "label": label, "value": value, "unit": unit, **extra})
+        log(f"  {label:52s} {value:12.4g} {unit}")
+
+    # exact ---------------------------------------------------------------------------
+    B, T = cfg["exact_bodies"], cfg["exact_times"]
+    w0 = bodies(B)
+    t = np.linspace(0.0, 100.0, T)
+    wall, tr, n = C.best_time(lambda: solve(I, t, omega0=w0, method="exact"), repeats=repeats, budget=20)
+    add("exact_solve", f"exact via solve ({B} bodies x {T} times)", B * T / wall, "evaluations/s",
+        us_per_evaluation=wall / (B * T) * 1e6, time_s=wall, timed_calls=n)
+    M0 = w0 * np.asarray(C.INERTIA)
+    wall, _, n = C.best_time(lambda: exact_motion(np.asarray(C.INERTIA), M0, t), repeats=repeats, budget=20)
+    add("exact_kernel", f"exact kernel exact_motion ({B} x {T})", B * T / wall, "evaluations/s",
+        us_per_evaluation=wall / (B * T) * 1e6, time_s=wall, timed_calls=n)
+
+    # taylor --------------------------------------------------------------------------
+    B, te = cfg["taylor_bodies"], cfg["taylor_t_end"]
+    w0 = bodies(B)
+    wall, tr, n = C.best_time(lambda: solve(I, [te], omega0=w0, method="taylor", tol=C.EPS),
+                              repeats=repeats, budget=30)
+    add("taylor_batch", f"taylor tol=eps batch ({B} bodies to t={te:g})", B * te / wall, "body-seconds/s",
+        time_s=wall, timed_calls=n, steps=tr.stats.get("steps"))
+    hy = C.heyoka_module()
+    if hy is not None:
+        rate, bs, wall, nb = C.heyoka_batch_throughput(hy, w0, te)
+        add("heyoka_batch", f"heyoka batch mode tol=eps (SIMD width {bs}, {nb} bodies)", rate, "body-seconds/s",
+            time_s=wall, simd_width=bs)
+        peer = C.HeyokaPeer(hy, C.EPS)
+        wall1, _, _ = C.best_time(lambda: peer.run(C.T_REF), repeats=5, budget=2)
+        add("heyoka_scalar", "heyoka scalar mode tol=eps (one body)", C.T_REF / wall1, "body-seconds/s",
+            time_s=wall1)
+
+    # symplectic ----------------------------------------------------------------------
+    B, ns, dt = cfg["symplectic_bodies"], cfg["symplectic_steps"], cfg["symplectic_dt"]
+    w0 = bodies(B)
+    for scheme, extra in (("splitting", {}), ("splitting4", {}), ("gauss4", {"variables": "quaternion"})):
+        wall, tr, n = C.best_time(
+            lambda: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt, **extra),
+            repeats=repeats, budget=30)
+        steps = int(tr.stats["steps"])
+        add(f"symplectic_{scheme}", f"symplectic {scheme} batch ({B} bodies x {steps} steps)", B * steps / wall,
+            "body-steps/s", time_s=wall, timed_calls=n)
+
+    # scipy ellipj yardstick ------------------------------------------------------------
+    from scipy.special import ellipj
+
+    N = cfg["ellipj_evaluations"]
+    rng = np.random.default_rng(1)
+    u = rng.uniform(0.0, 10.0, N)
+    m = rng.uniform(0.0, 0.99, N)
+    wall, _, n = C.best_time(lambda: ellipj(u, m), repeats=repeats, budget=10)
+    add("scipy_ellipj", f"scipy.special.ellipj ({N} evaluations)", wall / N * 1e9, "ns/evaluation",
+        time_s=wall, timed_calls=n)
+    return out
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import runpy
+    import sys
+    from pathlib import Path
+
+    sys.argv = [sys.argv[0], "--only", "throughput", *sys.argv[1:]]
+    runpy.run_path(str(Path(__file__).with_name("run.py")), run_name="__main__")

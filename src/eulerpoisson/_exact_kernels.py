@@ -68,7 +68,6 @@ References
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
@@ -83,19 +82,7 @@ __all__ = [
 ]
 
 
-def _numba_wanted() -> bool:
-    if os.environ.get("EULERPOISSON_NO_NUMBA", "") == "1":
-        return False
-    try:
-        import numba  # noqa: F401
-    except ImportError:  # pragma: no cover - depends on environment
-        return False
-    return True
-
-
-#: True when the compiled kernels are used (numba importable and
-#: ``EULERPOISSON_NO_NUMBA`` not ``"1"`` when this module was imported)
-USE_NUMBA = _numba_wanted()
+from ._compile import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
 # --- numerical constants: identical to those of _elliptic / _exact ----------
 _PI_HI = 3.141592653589793

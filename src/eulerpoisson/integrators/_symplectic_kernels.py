@@ -67,7 +67,6 @@ ed. (2006), VIII.6 (fixed-point iteration of implicit Runge-Kutta methods).
 from __future__ import annotations
 
 import math
-import os
 from decimal import Decimal, localcontext
 
 import numpy as np
@@ -88,19 +87,7 @@ __all__ = [
 ]
 
 
-def _numba_wanted() -> bool:
-    if os.environ.get("EULERPOISSON_NO_NUMBA", "") == "1":
-        return False
-    try:
-        import numba  # noqa: F401
-    except ImportError:  # pragma: no cover - depends on environment
-        return False
-    return True
-
-
-#: True when the compiled kernels are used (numba importable and
-#: ``EULERPOISSON_NO_NUMBA`` not ``"1"`` when this module was imported)
-USE_NUMBA = _numba_wanted()
+from .._compile import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
 #: bodies advanced in lockstep by the splitting kernel and by the Gauss kernel
 LANES_SPLITTING = 16

@@ -32,6 +32,10 @@ obtained with Cauchy products: with :math:`x(t) = \sum_k x_k t^k`,
 so order :math:`p` costs :math:`O(p^2)` per step (about 15 multiply-adds per
 term of the Cauchy sums).
 
+State updates are compensated: the state and the time are pairs (value,
+error) advanced by an error-free two-sum of the step's increment (Horner
+without the constant term), in both implementations and every arithmetic.
+
 References
 ----------
 A. Jorba and M. Zou, "A software package for the numerical integration of
@@ -310,6 +314,24 @@ def _horner(X, theta):
     return acc
 
 
+def _horner_delta(X, theta):
+    """X(theta) - X(0) for series X (p+1, 3, m) at theta (m,) (Horner without the constant term)."""
+    acc = X[-1].copy()
+    for k in range(X.shape[0] - 2, 0, -1):
+        acc = acc * theta + X[k]
+    return acc * theta
+
+
+def _two_sum_into(hi, lo, d, sel):
+    """hi[sel] + lo[sel] += d, compensated: hi the rounded sum, lo its exact error (two-sum)."""
+    h = hi[..., sel]
+    y = d + lo[..., sel]
+    s = h + y
+    z = s - h
+    lo[..., sel] = (h - (s - z)) + (y - z)
+    hi[..., sel] = s
+
+
 def _to_float(x):
     return np.asarray(x).astype(np.float64)
 
@@ -389,11 +411,16 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
             continue
         tlast = abs(tf[idx[-1]])
         tt = t[idx]
-        n = np.zeros((3, B), dtype=dtype)
+        # zeros of the working arithmetic (an int 0 in an object array would turn
+        # the sums below into float64 ones: mpf(x) + float is mpf, 0 + float is float)
+        zero = np.zeros(B, dtype=dtype) + moments[:, 0] * 0
+        n = np.stack([zero, zero, zero])
         w = w0c.copy()
+        nlo = n.copy()  # compensations: the state is (n + nlo, w + wlo)
+        wlo = n.copy()
         qr = np.ascontiguousarray(qref0.T).astype(dtype)
-        th = np.zeros(B, dtype=dtype)  # current time (Kahan sum of the steps)
-        tc = np.zeros(B, dtype=dtype)  # its compensation
+        th = zero.copy()  # current time th + tc (two-sum of the steps)
+        tc = zero.copy()
         ptr = np.zeros(B, dtype=np.int64)
         live = np.flatnonzero(stats[:, 2] == STATUS_OK)
         while live.size:
@@ -411,14 +438,14 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
             while True:
                 pend = ptr[live] < L
                 j = np.minimum(ptr[live], L - 1)
-                theta = (tt[j] - th[live]) + tc[live]
+                theta = (tt[j] - th[live]) - tc[live]
                 inside = pend & ~bad & (_to_float(sign * theta) <= h)
                 if not inside.any():
                     break
                 sel = live[inside]
                 thi = theta[inside]
-                nv = _horner(N[:, :, inside], thi)
-                wv = _horner(W[:, :, inside], thi)
+                nv = n[:, sel] + (_horner_delta(N[:, :, inside], thi) + nlo[:, sel])
+                wv = w[:, sel] + (_horner_delta(W[:, :, inside], thi) + wlo[:, sel])
                 cols = idx[ptr[sel]]
                 q_out[sel, cols] = _attitude_cols(qr[:, sel], nv).T
                 w_out[sel, cols] = wv.T
@@ -429,20 +456,28 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
             if adv.any():
                 sl = live[adv]
                 hv = hs[adv].astype(dtype)
-                n[:, sl] = _horner(N[:, :, adv], hv)
-                w[:, sl] = _horner(W[:, :, adv], hv)
-                # Kahan summation of the time
-                y = hv - tc[sl]
-                s = th[sl] + y
-                tc[sl] = (s - th[sl]) - y
+                # compensated state update (two-sum) and time
+                _two_sum_into(n, nlo, _horner_delta(N[:, :, adv], hv), sl)
+                _two_sum_into(w, wlo, _horner_delta(W[:, :, adv], hv), sl)
+                ts = th[sl]
+                s = ts + hv
+                z = s - ts
+                tc[sl] = tc[sl] + ((ts - (s - z)) + (hv - z))
                 th[sl] = s
                 nn = n[0, sl] * n[0, sl] + n[1, sl] * n[1, sl] + n[2, sl] * n[2, sl]
                 nnf = _to_float(nn)
                 chg = nnf > thr2
                 if chg.any():
                     sc = sl[chg]
-                    qr[:, sc] = _attitude_cols(qr[:, sc], n[:, sc])
-                    n[:, sc] = 0
+                    nc = n[:, sc]
+                    qr[:, sc] = _attitude_cols(qr[:, sc], nc)
+                    # R(n + nlo) = R(n) R(d), d = (nlo - n x nlo)/(1 + n.n) to first order
+                    lo = nlo[:, sc]
+                    den = 1 + nn[chg]
+                    nlo[0, sc] = (lo[0] - (nc[1] * lo[2] - nc[2] * lo[1])) / den
+                    nlo[1, sc] = (lo[1] - (nc[2] * lo[0] - nc[0] * lo[2])) / den
+                    nlo[2, sc] = (lo[2] - (nc[0] * lo[1] - nc[1] * lo[0])) / den
+                    n[:, sc] = zero[sc]
                     stats[sc, 1] += 1
                 nonfinite = ~np.isfinite(nnf) | ~np.isfinite(_to_float(w[:, sl]).sum(0))
                 stats[sl[nonfinite], 2] = STATUS_NONFINITE
@@ -464,17 +499,24 @@ def _nb_series(a0, a1, a2, n0, w0, order, N, W, S):
     W[0, 1] = w0[1]
     W[0, 2] = w0[2]
     for k in range(order):
-        s = 0.0
-        cx = 0.0
-        cy = 0.0
-        cz = 0.0
-        e0 = 0.0
-        e1 = 0.0
-        e2 = 0.0
+        # j = 0 term, then j = 1..k (no branch in the inner loop)
+        nx = N[0, 0]
+        ny = N[0, 1]
+        nz = N[0, 2]
+        wx = W[k, 0]
+        wy = W[k, 1]
+        wz = W[k, 2]
+        s = nx * wx + ny * wy + nz * wz
+        cx = ny * wz - nz * wy
+        cy = nz * wx - nx * wz
+        cz = nx * wy - ny * wx
+        e0 = W[0, 1] * wz
+        e1 = W[0, 2] * wx
+        e2 = W[0, 0] * wy
         sx = 0.0
         sy = 0.0
         sz = 0.0
-        for j in range(k + 1):
+        for j in range(1, k + 1):
             m = k - j
             nx = N[j, 0]
             ny = N[j, 1]
@@ -489,11 +531,10 @@ def _nb_series(a0, a1, a2, n0, w0, order, N, W, S):
             e0 += W[j, 1] * wz
             e1 += W[j, 2] * wx
             e2 += W[j, 0] * wy
-            if j > 0:
-                sm = S[m]
-                sx += sm * nx
-                sy += sm * ny
-                sz += sm * nz
+            sm = S[m]
+            sx += sm * nx
+            sy += sm * ny
+            sz += sm * nz
         S[k] = s
         sx += s * N[0, 0]
         sy += s * N[0, 1]
@@ -560,6 +601,29 @@ def _nb_horner(N, W, order, theta, n, w):
     w[2] = b2
 
 
+def _nb_horner_delta(N, W, order, theta, n, w):
+    """Increments n(theta) - n(0), Omega(theta) - Omega(0) (Horner without the constant term)."""
+    a0 = N[order, 0]
+    a1 = N[order, 1]
+    a2 = N[order, 2]
+    b0 = W[order, 0]
+    b1 = W[order, 1]
+    b2 = W[order, 2]
+    for k in range(order - 1, 0, -1):
+        a0 = a0 * theta + N[k, 0]
+        a1 = a1 * theta + N[k, 1]
+        a2 = a2 * theta + N[k, 2]
+        b0 = b0 * theta + W[k, 0]
+        b1 = b1 * theta + W[k, 1]
+        b2 = b2 * theta + W[k, 2]
+    n[0] = a0 * theta
+    n[1] = a1 * theta
+    n[2] = a2 * theta
+    w[0] = b0 * theta
+    w[1] = b1 * theta
+    w[2] = b2 * theta
+
+
 def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold, q_out, w_out, stats):
     B = moments.shape[0]
     N = np.zeros((order + 1, 3))
@@ -567,6 +631,10 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
     S = np.zeros(order + 1)
     n = np.zeros(3)
     w = np.zeros(3)
+    nlo = np.zeros(3)  # compensations: the state is (n + nlo, w + wlo)
+    wlo = np.zeros(3)
+    dn = np.zeros(3)
+    dw = np.zeros(3)
     qr = np.zeros(4)
     qtmp = np.zeros(4)
     nv = np.zeros(3)
@@ -604,6 +672,9 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
             w[0] = w0[b, 0]
             w[1] = w0[b, 1]
             w[2] = w0[b, 2]
+            for c in range(3):
+                nlo[c] = 0.0
+                wlo[c] = 0.0
             for c in range(4):
                 qr[c] = qref0[b, c]
             th = 0.0
@@ -647,10 +718,13 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
                 # dense output inside the step
                 while ptr < L:
                     j = idx[ptr]
-                    theta = (t[j] - th) + tc
+                    theta = (t[j] - th) - tc
                     if sign * theta > h:
                         break
-                    _nb_horner(N, W, order, theta, nv, wv)
+                    _nb_horner_delta(N, W, order, theta, dn, dw)
+                    for c in range(3):
+                        nv[c] = n[c] + (dn[c] + nlo[c])
+                        wv[c] = w[c] + (dw[c] + wlo[c])
                     _nb_attitude(qr, nv[0], nv[1], nv[2], qtmp)
                     for c in range(4):
                         q_out[b, j, c] = qtmp[c]
@@ -660,16 +734,36 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
                 if ptr >= L:
                     break
                 hs = sign * h
-                _nb_horner(N, W, order, hs, n, w)
-                y = hs - tc
-                s = th + y
-                tc = (s - th) - y
+                # compensated update x <- x + dx (two-sum: x + xlo is the state)
+                _nb_horner_delta(N, W, order, hs, dn, dw)
+                for c in range(3):
+                    y = dn[c] + nlo[c]
+                    s = n[c] + y
+                    z = s - n[c]
+                    nlo[c] = (n[c] - (s - z)) + (y - z)
+                    n[c] = s
+                    y = dw[c] + wlo[c]
+                    s = w[c] + y
+                    z = s - w[c]
+                    wlo[c] = (w[c] - (s - z)) + (y - z)
+                    w[c] = s
+                # time: two-sum, t = th + tc
+                s = th + hs
+                z = s - th
+                tc += (th - (s - z)) + (hs - z)
                 th = s
                 nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
                 if nn > thr2:
                     _nb_attitude(qr, n[0], n[1], n[2], qtmp)
                     for c in range(4):
                         qr[c] = qtmp[c]
+                    # R(n + nlo) = R(n) R(d), d = (nlo - n x nlo)/(1 + n.n) to first order
+                    d0 = (nlo[0] - (n[1] * nlo[2] - n[2] * nlo[1])) / (1.0 + nn)
+                    d1 = (nlo[1] - (n[2] * nlo[0] - n[0] * nlo[2])) / (1.0 + nn)
+                    d2 = (nlo[2] - (n[0] * nlo[1] - n[1] * nlo[0])) / (1.0 + nn)
+                    nlo[0] = d0
+                    nlo[1] = d1
+                    nlo[2] = d2
                     n[0] = 0.0
                     n[1] = 0.0
                     n[2] = 0.0
@@ -691,6 +785,7 @@ if USE_NUMBA:  # pragma: no branch
     _nb_series = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series)
     _nb_attitude = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_attitude)
     _nb_horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner)
+    _nb_horner_delta = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner_delta)
     _nb_coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_coefficients)
     _nb_integrate = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate)
 

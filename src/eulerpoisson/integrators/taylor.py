@@ -32,8 +32,20 @@ Jorba-Zou's mixed absolute/relative rule) and :math:`x=\boldsymbol\Omega`
 (scale :math:`s=\lVert\boldsymbol\Omega_0\rVert_\infty`, relative: the only
 unit-free choice for a quantity with units, which keeps the step invariant
 under a change of time unit). Output times inside a step are evaluated from
-the step's Taylor polynomial (Horner), so they cost nothing extra; the
-current time is a compensated (Kahan) sum of the steps.
+the step's Taylor polynomial (Horner), so they cost nothing extra.
+
+Round-off. At ``tol`` near machine epsilon the error is round-off, so the
+state is carried as an unevaluated sum :math:`x + \delta x` (the same for the
+time): each step adds the increment :math:`\sum_{k\ge1}x_kh^k` (Horner
+without the constant term) by an error-free two-sum (Knuth; Møller), and the
+small part :math:`\delta\mathbf n` survives a chart change as the Gibbs
+vector :math:`(\delta\mathbf n - \mathbf n\times\delta\mathbf n)/(1+n^2)`
+of :math:`R(\mathbf n)^{-1}R(\mathbf n+\delta\mathbf n)` (first order).
+This brought the attitude error at t = 100 for :math:`I=\mathrm{diag}(1,2,3)`,
+:math:`\boldsymbol\Omega_0=(1,0.1,0.5)`, ``tol`` = eps from 2.1e-14 to
+1.5e-15 rad, and the relative energy error at t = 1e5 from 6e-14 to 1.3e-15.
+In ``mpmath``/``longdouble`` arithmetic every sum stays in that arithmetic
+(the float64 steps enter exactly).
 
 Charts through :math:`\alpha=\pi`. :math:`\mathbf n=\mathbf k\tan(\alpha/2)`
 is infinite at :math:`\alpha=\pi`, which every tumbling body reaches. The free
@@ -64,7 +76,8 @@ References
 ----------
 Paper eq. 1.15-1.16, 1.23.1, 1.26, 1.30. A. Jorba and M. Zou, "A software
 package for the numerical integration of ODEs by means of high-order Taylor
-methods", Exp. Math. 14 (2005) 99-117. W. Gröbner, *Die Lie-Reihen und ihre
+methods", Exp. Math. 14 (2005) 99-117. D. E. Knuth, *The Art of Computer
+Programming* vol. 2, 3rd ed. (1997), sec. 4.2.2 (two-sum). W. Gröbner, *Die Lie-Reihen und ihre
 Anwendungen* (1960). A. Griewank and A. Walther, *Evaluating Derivatives*,
 2nd ed., SIAM (2008), ch. 13 (Taylor-mode arithmetic).
 """

@@ -46,7 +46,6 @@ Paper eq. 1.16, 1.23.1, 1.30.
 from __future__ import annotations
 
 import math
-import os
 
 import numpy as np
 
@@ -71,19 +70,7 @@ STATUS_MAX_STEPS = 1
 STATUS_NONFINITE = 2
 
 
-def _numba_wanted() -> bool:
-    if os.environ.get("EULERPOISSON_NO_NUMBA", "") == "1":
-        return False
-    try:
-        import numba  # noqa: F401
-    except ImportError:  # pragma: no cover - depends on environment
-        return False
-    return True
-
-
-#: True when the compiled kernels are used (numba importable and
-#: ``EULERPOISSON_NO_NUMBA`` not set to ``"1"`` when this module was imported)
-USE_NUMBA = _numba_wanted()
+from .._compile import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
 
 def auto_order(tol: float) -> int:

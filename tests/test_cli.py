@@ -165,3 +165,19 @@ def test_simulate_streams_to_zarr(capsys, tmp_path):
     code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
                          "--out", str(tmp_path / "r.txt"))
     assert code == 2 and ".nc (NetCDF) or .zarr" in err
+
+
+def test_long_simulate_works_in_chunks(capsys, tmp_path):
+    from eulerpoisson.cli import CHUNKED_SAMPLES
+
+    n = CHUNKED_SAMPLES + 1
+    path = tmp_path / "long.nc"
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "50",
+                         "--samples", str(n), "--method", "taylor", "--out", str(path), "--json")
+    assert code == 0, err
+    assert err == ""  # no progress bar without a terminal
+    tr = ep.Trajectory.from_netcdf(path)
+    assert tr.t.size == n and tr.stats["chunks"] > 1
+    ref = ep.solve([1, 2, 3], tr.t, omega0=[1, 0.1, 0.5])
+    np.testing.assert_allclose(tr.omega, ref.omega, atol=1e-12)
+    assert np.max(np.abs(np.abs(np.sum(tr.quaternion * ref.quaternion, -1)) - 1)) < 1e-13

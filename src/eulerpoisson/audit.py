@@ -53,7 +53,6 @@ import functools
 import json
 import os
 import random
-import tempfile
 import time
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -62,6 +61,7 @@ import numpy as np
 
 from . import symbolic as _sym
 from ._audit_entries import ENTRIES, CheckSpec, EntrySpec
+from ._io import atomic_write_text
 from .errors import EulerPoissonError, InvalidInputError
 
 __all__ = [
@@ -1869,13 +1869,5 @@ def write_report(report: AuditReport, fmt: str, path) -> str:
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):
         raise InvalidInputError(f"path {path!r}: directory {directory!r} does not exist")
-    fd, tmp = tempfile.mkstemp(prefix=".audit-", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    atomic_write_text(path, text)
     return path

@@ -159,6 +159,49 @@ def _state_json(traj, drift) -> dict:
     }
 
 
+#: output samples above which ``simulate`` works in chunks (and shows a progress bar on a terminal)
+CHUNKED_SAMPLES = 5000
+CHUNKS = 50
+
+
+def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
+    """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
+
+    The chunking depends only on the number of samples (never on whether a
+    terminal is attached), so a run gives the same numbers everywhere. The
+    closed form evaluates every chunk from the initial state (identical to one
+    call); stepping methods continue each chunk from the last state of the
+    previous one, as :func:`eulerpoisson.stream.solve_to_file` does.
+    """
+    from .solvers import get_method, solve
+    from .stream import _Progress
+    from .trajectory import Trajectory
+
+    if t.size < CHUNKED_SAMPLES:
+        return solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    closed_form = get_method(method).order is None
+    pieces = np.array_split(np.arange(t.size), CHUNKS)
+    qs, ws, wall = [], [], 0.0
+    first = None
+    with _Progress(progress, t.size, f"{method}: solving") as bar:
+        done = 0
+        for idx in pieces:
+            if closed_form or first is None:
+                tr = solve(body, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+            else:
+                t0 = t[qs_end_index]
+                tr = solve(body, t[idx] - t0, omega0=ws[-1][-1], attitude0=qs[-1][-1], method=method, **opts)
+            first = tr if first is None else first
+            qs.append(tr.quaternion)
+            ws.append(tr.omega)
+            qs_end_index = idx[-1]
+            wall += tr.stats.get("wall_time", 0.0)
+            done += idx.size
+            bar.update(done)
+    stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
+    return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats)
+
+
 def cmd_simulate(args) -> int:
     from .attitude import quaternion_from_gibbs
     from .solvers import available_methods, solve
@@ -246,7 +289,8 @@ def cmd_simulate(args) -> int:
         traj = solve(body, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
     else:
         t = np.linspace(0.0, t_end, samples)
-        traj = solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        progress = False if (args.quiet or args.json) else None
+        traj = _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress)
         if out:
             if not str(out).endswith((".nc", ".nc4", ".netcdf")):
                 raise UsageError(f"--out {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")

@@ -90,7 +90,9 @@ def run_demo(out="out", *, quiet: bool = False, t_end: float = 400.0, samples: i
     say(f"  time between flips: measured {half_measured:.12g}, closed form 2K(k)/lambda = {half_exact:.12g}"
         f" (relative difference {abs(half_measured - half_exact) / half_exact:.1e})")
     say("  integrals of motion, max relative drift: " + ", ".join(f"{k} {v:.1e}" for k, v in drift.items()))
-    say(f"  audit: {report.summary_line() if hasattr(report, 'summary_line') else ''}".rstrip())
+    counts = report.summary()["counts"]
+    say("  audit of the paper: " + ", ".join(f"{v} {k}" for k, v in counts.items())
+        + " (misprints in eq. " + ", ".join(m["equation"] for m in report.summary()["misprints"]) + ")")
     say(f"  wrote {len(files)} files into {out}/ in {wall:.1f} s:")
     for f in files:
         say(f"    {f}")

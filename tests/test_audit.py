@@ -26,8 +26,8 @@ from eulerpoisson.errors import InvalidInputError  # noqa: E402
 NUMBERED = [f"1.{k}" for k in range(1, 31)] + ["1.15.1", "1.16.1", "1.23.1"]
 PAPER_CANDIDATES = [
     os.environ.get("EULERPOISSON_PAPER", ""),
+    os.path.join(os.path.dirname(__file__), "..", "..", "shared", "paper", "paper.tex"),  # shared/ beside the clone
     "/work/shared/paper/paper.tex",
-    os.path.join(os.path.dirname(__file__), "..", "paper", "paper.tex"),
 ]
 
 

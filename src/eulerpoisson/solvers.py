@@ -231,7 +231,7 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
         nrm = np.linalg.norm(q0, axis=-1)
         if np.any(np.abs(nrm - 1.0) > 1e-8):
             raise InvalidInputError(
-                f"attitude0 must be a unit quaternion (w, x, y, z); its norm is {nrm.ravel()[0]!r}"
+                f"attitude0 must be a unit quaternion (w, x, y, z); its norm is {float(nrm.ravel()[np.argmax(np.abs(nrm.ravel() - 1.0))]):.9g}"
             )
         q0 = _as_quaternion(q0, "attitude0")
     if omega0 is not None:

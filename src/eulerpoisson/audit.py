@@ -1673,7 +1673,8 @@ def _to_markdown(rep: AuditReport) -> str:
     integ = rep.integrability
     if integ:
         for k, v in integ["involution"].items():
-            out.append(f"- ${k}$ = {v}")
+            kk = k.replace("{", r"\{").replace("}", r"\}").replace("m^2", r"\mathbf m^2")
+            out.append(f"- ${kk}$ = {v}")
         out.append(f"- rank of the Jacobian of $(H, \\mathbf m^2, m_3)$ w.r.t. $(\\mathbf n, \\boldsymbol\\pi)$: {integ['jacobian_rank']} (random rational points: {integ['jacobian_ranks_at_random_points']})")
         for chart, name in (("nm", "(n, m)"), ("nOmega", "(n, Omega)"), ("nM", "(n, M)")):
             out.append(f"- Poisson tensor in {name}: Pfaffian ${integ['pfaffian_' + chart + '_latex']}$, determinant ${integ['det_' + chart + '_latex']}$")

@@ -77,11 +77,14 @@ class Trajectory:
             raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
         # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
         q = np.where(np.abs(nrm - 1.0) > 4 * np.finfo(float).eps, q / nrm, q)
-        order = np.argsort(self.t, kind="stable")
-        qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
-        inv = np.empty_like(order)
-        inv[order] = np.arange(order.size)
-        self.quaternion = np.take(qs, inv, axis=-2)
+        if self.t.size < 2 or np.all(self.t[1:] >= self.t[:-1]):  # the usual case: no reordering needed
+            self.quaternion = quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
+        else:
+            order = np.argsort(self.t, kind="stable")
+            qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
+            inv = np.empty_like(order)
+            inv[order] = np.arange(order.size)
+            self.quaternion = np.take(qs, inv, axis=-2)
         self.body = body
         self.method = method
         self.options = dict(options or {})

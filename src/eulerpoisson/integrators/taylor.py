@@ -174,6 +174,15 @@ def _euler_coefficients(m):
     return np.stack([(I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3])
 
 
+def _check_series_order(order) -> int:
+    """Validate the order of a Taylor-coefficient request (0 to ``MAX_ORDER``)."""
+    if isinstance(order, bool) or not isinstance(order, (numbers.Integral, np.integer)):
+        raise TypeError(f"order must be an integer, got {type(order).__name__} {order!r}")
+    if not 0 <= int(order) <= MAX_ORDER:
+        raise InvalidInputError(f"order must be between 0 and {MAX_ORDER}, got {order!r}")
+    return int(order)
+
+
 def taylor_coefficients(n0, omega0, inertia, order):
     r"""Taylor coefficients of :math:`(\mathbf n(t), \boldsymbol\Omega(t))` through a state (eq. 1.30).
 
@@ -220,11 +229,7 @@ def taylor_coefficients(n0, omega0, inertia, order):
     >>> nk[:, 0].tolist()   # tan(t/2) = t/2 + t^3/24 + ...
     [0.0, 0.5, 0.0, 0.041666666666666664]
     """
-    if isinstance(order, bool) or not isinstance(order, (numbers.Integral, np.integer)):
-        raise TypeError(f"order must be an integer, got {type(order).__name__} {order!r}")
-    if not 0 <= int(order) <= MAX_ORDER:
-        raise InvalidInputError(f"order must be between 0 and {MAX_ORDER}, got {order!r}")
-    order = int(order)
+    order = _check_series_order(order)
     n = np.moveaxis(_as_array(n0, "n0", (3,)), -1, 0)
     w = np.moveaxis(_as_array(omega0, "omega0", (3,)), -1, 0)
     parts = _inertia_parts(inertia)
@@ -287,11 +292,7 @@ def lie_series_coefficients(n0, pi0, inertia, order):
     ----------
     Paper eq. 1.15, 1.16, 1.23.1, 1.26.
     """
-    if isinstance(order, bool) or not isinstance(order, (numbers.Integral, np.integer)):
-        raise TypeError(f"order must be an integer, got {type(order).__name__} {order!r}")
-    if not 0 <= int(order) <= MAX_ORDER:
-        raise InvalidInputError(f"order must be between 0 and {MAX_ORDER}, got {order!r}")
-    order = int(order)
+    order = _check_series_order(order)
     n = np.moveaxis(_as_array(n0, "n0", (3,)), -1, 0)
     p = np.moveaxis(_as_array(pi0, "pi0", (3,)), -1, 0)
     parts = _inertia_parts(inertia)

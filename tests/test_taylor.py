@@ -521,9 +521,10 @@ def test_batch_equals_bodies_solved_alone():
     t = np.array([4.0, -2.5, 0.0, 11.0])
     batch = solve(RigidBody(inertia), t, omega0=w0, attitude0=q0, method="taylor")
     assert batch.quaternion.shape == (2, 3, 4, 4)
-    # compiled: the same operations per body, identical; NumPy path: reductions over
-    # batches of another size may sum in another order (round-off)
-    atol = 1e-15 if K.USE_NUMBA else 1e-13
+    # compiled: a batch of 6 runs the lane (SIMD) kernel, a body alone the scalar one: the
+    # same steps, round-off apart (LLVM fuses a few multiply-adds differently in vector
+    # code); NumPy path: reductions over batches of another size may sum in another order
+    atol = 1e-14 if K.USE_NUMBA else 1e-13
     steps = 0
     for i in range(2):
         for j in range(3):
@@ -539,6 +540,81 @@ def test_batch_equals_bodies_solved_alone():
         one = solve(moments[i], t, omega0=[0.3, 1.0, -0.2], method="taylor")
         np.testing.assert_allclose(b2.quaternion[i], one.quaternion, rtol=0, atol=atol)
         np.testing.assert_allclose(b2.omega[i], one.omega, rtol=0, atol=atol)
+
+
+def _lane_batch(rng, B):
+    """B bodies whose step counts differ by 100x (lanes are refilled at different times),
+    with a symmetric top, a sphere, a body at rest and one with a NaN velocity."""
+    m = np.sort(rng.uniform(1.0, 3.0, (B, 3)), axis=1)
+    m[1] = [1.0, 1.0, 1.7]
+    m[2] = [2.0, 2.0, 2.0]
+    w0 = rng.standard_normal((B, 3)) * rng.choice([0.05, 1.0, 5.0], (B, 1))
+    w0[3] = 0.0
+    w0[4, 1] = np.nan
+    q0 = Attitude.random(B, rng=rng).as_quaternion()
+    return m, w0, q0
+
+
+@pytest.mark.skipif(not K.USE_NUMBA, reason="the lane kernel is compiled (numba not in use)")
+@pytest.mark.parametrize("dt, order", [(None, 20), (None, 9), (0.07, 12), (0.5, 1)])
+def test_lane_kernel_equals_scalar_kernel(dt, order):
+    rng = np.random.default_rng(11)
+    B = 2 * K.LANES_TAYLOR + 5  # idle lanes at the end
+    m, w0, q0 = _lane_batch(rng, B)
+    t = np.array([3.0, -7.5, 0.0, 12.0, -0.25, 3.0, 25.0])
+    max_steps = 800 if order == 20 else 4000  # order 20: the two fastest bodies need ~1000
+    kw = dict(tol=1e-15 if order == 20 else 1e-9, order=order, dt=dt, max_steps=max_steps, threshold=1.0)
+    qs, ws, ss = K.integrate_numba(m, w0, q0, t, lanes=False, **kw)
+    ql, wl, sl = K.integrate_numba(m, w0, q0, t, lanes=True, **kw)
+    # the same steps, chart changes and verdicts, body by body
+    np.testing.assert_array_equal(sl, ss)
+    assert ss[4, 2] == K.STATUS_NONFINITE and ss[3, 2] == K.STATUS_OK
+    assert set(ss[:, 2]) >= {K.STATUS_OK, K.STATUS_NONFINITE}
+    if dt is None and order == 20:  # the fastest bodies run out of steps
+        assert K.STATUS_MAX_STEPS in ss[:, 2]
+    assert ss[:, 1].max() > 10  # chart changes happen
+    ok = ss[:, 2] == K.STATUS_OK
+    scale = np.maximum(np.abs(w0[ok]).max(axis=1), 1e-300)[:, None, None]
+    # round-off, relative to the angle turned (|w| t) and to |w| (measured: <= 1.5e-16)
+    turns = 1 + scale * np.abs(t)[None, :, None]
+    assert np.max(np.abs(ql[ok] - qs[ok]) / turns) < 1e-14
+    assert np.max(np.abs(wl[ok] - ws[ok]) / (scale * turns)) < 1e-14
+    np.testing.assert_array_equal(wl[3], np.zeros((t.size, 3)))  # at rest
+    # outputs of failed bodies are not written, in either kernel
+    np.testing.assert_array_equal(ql[~ok] == 0, qs[~ok] == 0)
+
+
+_LANES_PY_SCRIPT = r"""
+import json, sys
+import numpy as np
+from eulerpoisson.integrators import _taylor_kernels as K
+m, w0, q0, t = (np.array(json.loads(a)) for a in sys.argv[1:5])
+kw = dict(tol=1e-9, order=8, dt=None, max_steps=500, threshold=1.0)
+a = K.integrate_numba(m, w0, q0, t, lanes=False, **kw)
+b = K.integrate_numba(m, w0, q0, t, lanes=True, **kw)
+print(json.dumps({"use_numba": K.USE_NUMBA, "equal": [bool(np.array_equal(x, y)) for x, y in zip(a, b)],
+                  "stats": a[2].tolist()}))
+"""
+
+
+def test_lane_kernel_logic_equals_scalar_kernel_bit_for_bit_in_python():
+    """Without the compiler both kernels run as plain Python (no fused multiply-add anywhere):
+    the lane bookkeeping (refills, directions, idle lanes, failures) must then give
+    exactly the scalar kernel's numbers."""
+    rng = np.random.default_rng(12)
+    m, w0, q0 = _lane_batch(rng, K.LANES_TAYLOR + 3)
+    w0 *= 0.5
+    t = np.array([1.5, -2.0, 0.0, 4.0, 1.5])
+    args = [json.dumps(np.where(np.isnan(x), None, x).tolist()) for x in (m, w0, q0, t)]
+    env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
+    out = subprocess.run([sys.executable, "-c", _LANES_PY_SCRIPT, *args], env=env, capture_output=True,
+                         text=True, timeout=300, check=True)
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    assert res["use_numba"] is False
+    assert res["equal"] == [True, True, True]
+    st = np.array(res["stats"])
+    assert st[4, 2] == K.STATUS_NONFINITE and (st[:, 2] == K.STATUS_OK).sum() == len(st) - 1
+    assert st[:, 1].sum() > 0
 
 
 # ---------------------------------------------------------------------------

@@ -2,8 +2,11 @@ r"""Taylor-mode recurrences and the stepping loop of the ``taylor`` method (priv
 
 Two implementations of the same algorithm live here:
 
-* compiled kernels (numba, ``@njit(cache=True)``, scalar loops over fixed-size
-  arrays, one body after the other so that every body has its own steps);
+* compiled kernels (numba, ``@njit(cache=True)``): a scalar kernel, one body
+  after the other in scalar loops over fixed-size arrays, and a *lane* kernel
+  that advances ``LANES_TAYLOR`` (16) bodies in lockstep (SIMD), used for
+  batches of ``LANES_MIN_BODIES`` (5) bodies or more. Every body has its own
+  steps in both;
 * a generic NumPy path, vectorized over the bodies, that only uses ``+ - * /``
   (dividing by integers), comparisons and one square root per chart change
   on the coefficient arrays, so that it runs unchanged with ``float64``,
@@ -17,6 +20,29 @@ module); otherwise the NumPy path runs. Both take the same steps and give the
 same results to round-off: the compiled kernels let LLVM fuse multiply-adds
 (``fastmath={"contract"}`` only, no reassociation) and sum the Cauchy
 products in a different order.
+
+Lane kernel
+    A single body is a chain of dependent multiply-adds (the Cauchy sums of
+    order 20 at tol = eps) that keeps one core at about 5e5 body-seconds per
+    second. The lane kernel stores coefficient k of lane l at
+    ``k*7*L + row*L + l`` (rows n, Omega and S = n.Omega, ``L = 16``) and runs
+    the scalar kernel's operations lane by lane with the lane loop innermost,
+    which LLVM turns into AVX2/AVX-512 code. Two details make that happen:
+    the j-th Cauchy term is read through row *views* (``buf[j*7L:(j+1)*7L]``)
+    so that every index is a non-negative constant plus the lane (numba's
+    negative-index wrap-around otherwise turns the loads into gathers), and
+    the running sums live in a stack buffer (:func:`~eulerpoisson._compile.stack_buffer`,
+    an ``alloca``) that LLVM knows aliases no array, so no run-time overlap
+    check is needed (for a 16-trip loop LLVM would not emit one and would not
+    vectorize). Step sizes, dense output and chart changes are done lane by
+    lane; a lane whose body is done takes the next body, so lanes stay busy
+    until the queue is empty. Measured (2-core AMD EPYC, one thread, tol =
+    eps, order 20): the series costs 150 ns per body and step against 620 ns
+    for the scalar kernel; the whole integration makes 1.3e6 to 1.5e6
+    body-seconds per second against 4.8e5 (heyoka's batch mode: 1.4e6).
+    The lane kernel takes the same steps as the scalar kernel; its results
+    agree to round-off (measured: 1.5e-16 relative; plain Python runs of both
+    agree bit for bit, which the tests check).
 
 The recurrences (principal frame, :math:`a_1 = (I_2-I_3)/I_1` and cyclic) are
 the Taylor coefficients of the solution of the paper's eq. 1.30,
@@ -71,6 +97,7 @@ STATUS_NONFINITE = 2
 
 
 from .._compile import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
+from .._compile import stack_buffer
 
 
 def auto_order(tol: float) -> int:
@@ -478,6 +505,17 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
 # ---------------------------------------------------------------------------
 # compiled kernels
 # ---------------------------------------------------------------------------
+def _nb_mul(x, y):
+    """x * y rounded once (compiled without ``contract``: never fused into a later add).
+
+    The last product of a Horner increment is added to a compensation term;
+    whether LLVM fuses that multiply-add would depend on how the kernel keeps
+    its state (registers or memory), so the scalar and lane kernels round it
+    explicitly and agree bit for bit.
+    """
+    return x * y
+
+
 def _nb_series(a0, a1, a2, n0, w0, order, N, W, S):
     N[0, 0] = n0[0]
     N[0, 1] = n0[1]
@@ -549,20 +587,29 @@ def _nb_coefficients(moments, n0, w0, order):
     return N, W
 
 
-def _nb_attitude(qr, nx, ny, nz, out):
-    pw = qr[0]
-    px = qr[1]
-    py = qr[2]
-    pz = qr[3]
+def _nb_quat_gibbs(pw, px, py, pz, nx, ny, nz):
+    """Unit quaternion p (x) (1, n)/|(1, n)| (compiled without ``contract``, as :func:`_nb_chart`)."""
     q0 = pw - px * nx - py * ny - pz * nz
     q1 = pw * nx + px + py * nz - pz * ny
     q2 = pw * ny - px * nz + py + pz * nx
     q3 = pw * nz + px * ny - py * nx + pz
     r = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    out[0] = q0 / r
-    out[1] = q1 / r
-    out[2] = q2 / r
-    out[3] = q3 / r
+    return q0 / r, q1 / r, q2 / r, q3 / r
+
+
+def _nb_chart(nx, ny, nz, lx, ly, lz):
+    """Compensation carried into the new chart: d = (nlo - n x nlo)/(1 + n.n).
+
+    R(n + nlo) = R(n) R(d) to first order in nlo. Compiled without
+    ``contract``, like :func:`_nb_quat_gibbs`: the chart change is rare, and
+    unfused it rounds the same in the scalar and the lane kernel.
+    """
+    den = 1.0 + (nx * nx + ny * ny + nz * nz)
+    return (
+        (lx - (ny * lz - nz * ly)) / den,
+        (ly - (nz * lx - nx * lz)) / den,
+        (lz - (nx * ly - ny * lx)) / den,
+    )
 
 
 def _nb_horner(N, W, order, theta, n, w):
@@ -603,12 +650,12 @@ def _nb_horner_delta(N, W, order, theta, n, w):
         b0 = b0 * theta + W[k, 0]
         b1 = b1 * theta + W[k, 1]
         b2 = b2 * theta + W[k, 2]
-    n[0] = a0 * theta
-    n[1] = a1 * theta
-    n[2] = a2 * theta
-    w[0] = b0 * theta
-    w[1] = b1 * theta
-    w[2] = b2 * theta
+    n[0] = _nb_mul(a0, theta)
+    n[1] = _nb_mul(a1, theta)
+    n[2] = _nb_mul(a2, theta)
+    w[0] = _nb_mul(b0, theta)
+    w[1] = _nb_mul(b1, theta)
+    w[2] = _nb_mul(b2, theta)
 
 
 def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold, q_out, w_out, stats):
@@ -712,9 +759,11 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
                     for c in range(3):
                         nv[c] = n[c] + (dn[c] + nlo[c])
                         wv[c] = w[c] + (dw[c] + wlo[c])
-                    _nb_attitude(qr, nv[0], nv[1], nv[2], qtmp)
-                    for c in range(4):
-                        q_out[b, j, c] = qtmp[c]
+                    q0, q1, q2, q3 = _nb_quat_gibbs(qr[0], qr[1], qr[2], qr[3], nv[0], nv[1], nv[2])
+                    q_out[b, j, 0] = q0
+                    q_out[b, j, 1] = q1
+                    q_out[b, j, 2] = q2
+                    q_out[b, j, 3] = q3
                     for c in range(3):
                         w_out[b, j, c] = wv[c]
                     ptr += 1
@@ -741,13 +790,12 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
                 th = s
                 nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
                 if nn > thr2:
-                    _nb_attitude(qr, n[0], n[1], n[2], qtmp)
-                    for c in range(4):
-                        qr[c] = qtmp[c]
-                    # R(n + nlo) = R(n) R(d), d = (nlo - n x nlo)/(1 + n.n) to first order
-                    d0 = (nlo[0] - (n[1] * nlo[2] - n[2] * nlo[1])) / (1.0 + nn)
-                    d1 = (nlo[1] - (n[2] * nlo[0] - n[0] * nlo[2])) / (1.0 + nn)
-                    d2 = (nlo[2] - (n[0] * nlo[1] - n[1] * nlo[0])) / (1.0 + nn)
+                    q0, q1, q2, q3 = _nb_quat_gibbs(qr[0], qr[1], qr[2], qr[3], n[0], n[1], n[2])
+                    qr[0] = q0
+                    qr[1] = q1
+                    qr[2] = q2
+                    qr[3] = q3
+                    d0, d1, d2 = _nb_chart(n[0], n[1], n[2], nlo[0], nlo[1], nlo[2])
                     nlo[0] = d0
                     nlo[1] = d1
                     nlo[2] = d2
@@ -766,15 +814,406 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
         stats[b, 2] = status
 
 
+# ---------------------------------------------------------------------------
+# compiled kernel in lanes: LANES_TAYLOR bodies advanced together (SIMD)
+# ---------------------------------------------------------------------------
+LANES_TAYLOR = 16
+#: fewest bodies for which integrate_numba runs the lane kernel by default
+LANES_MIN_BODIES = 5
+_TL = LANES_TAYLOR
+# one Taylor coefficient of all lanes: rows n_x n_y n_z, W_x W_y W_z, S (= n.Omega), L each
+_TR = 7 * _TL
+_CN, _CW, _CS = 0, 3 * _TL, 6 * _TL
+# Cauchy-sum accumulators of the series kernel: s, n x W (3), W x W terms (3), S n (3)
+_ACC = 10 * _TL
+# lane state (rows of L): n, Omega, their compensations, reference quaternion,
+# time (hi, lo), signed step, Horner increments of n and Omega
+_XN, _XW, _XNL, _XWL = 0, 3 * _TL, 6 * _TL, 9 * _TL
+_XQ = 12 * _TL
+_XTH, _XTC, _XH = 16 * _TL, 17 * _TL, 18 * _TL
+_XDN, _XDW = 19 * _TL, 22 * _TL
+_XSIZE = 25 * _TL
+
+
+def _nb_series_lanes(a, buf, order):
+    """Taylor coefficients 1..order of all lanes from coefficient 0 (lane layout).
+
+    ``buf`` holds coefficient k of lane l at ``k*_TR + row*_TL + l``; ``a`` the
+    Euler coefficients (3 rows of L). The same operations in the same order
+    as :func:`_nb_series`, lane by lane: the j-th Cauchy term is read through
+    two row views (non-negative constant offsets, contiguous in the lanes)
+    and summed into a stack buffer, so LLVM vectorizes the lane loops.
+    """
+    acc = stack_buffer(_ACC)
+    for k in range(order):
+        ok = k * _TR
+        ck = buf[ok:ok + _TR]
+        for l in range(_TL):
+            nx = buf[_CN + l]
+            ny = buf[_CN + _TL + l]
+            nz = buf[_CN + 2 * _TL + l]
+            wx = ck[_CW + l]
+            wy = ck[_CW + _TL + l]
+            wz = ck[_CW + 2 * _TL + l]
+            acc[l] = nx * wx + ny * wy + nz * wz
+            acc[_TL + l] = ny * wz - nz * wy
+            acc[2 * _TL + l] = nz * wx - nx * wz
+            acc[3 * _TL + l] = nx * wy - ny * wx
+            acc[4 * _TL + l] = buf[_CW + _TL + l] * wz
+            acc[5 * _TL + l] = buf[_CW + 2 * _TL + l] * wx
+            acc[6 * _TL + l] = buf[_CW + l] * wy
+            acc[7 * _TL + l] = 0.0
+            acc[8 * _TL + l] = 0.0
+            acc[9 * _TL + l] = 0.0
+        for j in range(1, k + 1):
+            oj = j * _TR
+            om = (k - j) * _TR
+            cj = buf[oj:oj + _TR]
+            cm = buf[om:om + _TR]
+            for l in range(_TL):
+                nx = cj[_CN + l]
+                ny = cj[_CN + _TL + l]
+                nz = cj[_CN + 2 * _TL + l]
+                wx = cm[_CW + l]
+                wy = cm[_CW + _TL + l]
+                wz = cm[_CW + 2 * _TL + l]
+                acc[l] += nx * wx + ny * wy + nz * wz
+                acc[_TL + l] += ny * wz - nz * wy
+                acc[2 * _TL + l] += nz * wx - nx * wz
+                acc[3 * _TL + l] += nx * wy - ny * wx
+                acc[4 * _TL + l] += cj[_CW + _TL + l] * wz
+                acc[5 * _TL + l] += cj[_CW + 2 * _TL + l] * wx
+                acc[6 * _TL + l] += cj[_CW + l] * wy
+                sm = cm[_CS + l]
+                acc[7 * _TL + l] += sm * nx
+                acc[8 * _TL + l] += sm * ny
+                acc[9 * _TL + l] += sm * nz
+        d = 2.0 * (k + 1)
+        e = 1.0 * (k + 1)
+        for l in range(_TL):
+            s = acc[l]
+            sx = acc[7 * _TL + l] + s * buf[_CN + l]
+            sy = acc[8 * _TL + l] + s * buf[_CN + _TL + l]
+            sz = acc[9 * _TL + l] + s * buf[_CN + 2 * _TL + l]
+            acc[7 * _TL + l] = (ck[_CW + l] + acc[_TL + l] + sx) / d
+            acc[8 * _TL + l] = (ck[_CW + _TL + l] + acc[2 * _TL + l] + sy) / d
+            acc[9 * _TL + l] = (ck[_CW + 2 * _TL + l] + acc[3 * _TL + l] + sz) / d
+            acc[4 * _TL + l] = a[l] * acc[4 * _TL + l] / e
+            acc[5 * _TL + l] = a[_TL + l] * acc[5 * _TL + l] / e
+            acc[6 * _TL + l] = a[2 * _TL + l] * acc[6 * _TL + l] / e
+        o1 = ok + _TR
+        c1 = buf[o1:o1 + _TR]
+        for l in range(_TL):
+            ck[_CS + l] = acc[l]
+            c1[_CN + l] = acc[7 * _TL + l]
+            c1[_CN + _TL + l] = acc[8 * _TL + l]
+            c1[_CN + 2 * _TL + l] = acc[9 * _TL + l]
+            c1[_CW + l] = acc[4 * _TL + l]
+            c1[_CW + _TL + l] = acc[5 * _TL + l]
+            c1[_CW + 2 * _TL + l] = acc[6 * _TL + l]
+
+
+def _nb_lane_horner_delta(buf, l, order, theta):
+    """Increments n(theta) - n(0), Omega(theta) - Omega(0) of lane l (as :func:`_nb_horner_delta`)."""
+    o = order * _TR + l
+    a0 = buf[o]
+    a1 = buf[o + _TL]
+    a2 = buf[o + 2 * _TL]
+    b0 = buf[o + 3 * _TL]
+    b1 = buf[o + 4 * _TL]
+    b2 = buf[o + 5 * _TL]
+    for k in range(order - 1, 0, -1):
+        o = k * _TR + l
+        a0 = a0 * theta + buf[o]
+        a1 = a1 * theta + buf[o + _TL]
+        a2 = a2 * theta + buf[o + 2 * _TL]
+        b0 = b0 * theta + buf[o + 3 * _TL]
+        b1 = b1 * theta + buf[o + 4 * _TL]
+        b2 = b2 * theta + buf[o + 5 * _TL]
+    return (_nb_mul(a0, theta), _nb_mul(a1, theta), _nb_mul(a2, theta),
+            _nb_mul(b0, theta), _nb_mul(b1, theta), _nb_mul(b2, theta))
+
+
+def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold,
+                        q_out, w_out, stats, buf, lane_a, lane_i, lane_f):
+    """:func:`_nb_integrate` with ``_TL`` bodies in lockstep, one per lane.
+
+    Every lane runs the scalar kernel's algorithm on its own body (its own
+    steps, outputs and chart changes); when a body is done the lane takes
+    the next one, so the lanes stay busy until the last bodies. The Taylor
+    coefficients and the state update are computed for all lanes at once
+    (vector code); step sizes, dense output and chart changes lane by lane.
+    ``buf`` ((order+1)*_TR), ``lane_a`` (3*_TL), ``lane_i`` (10*_TL int64) and
+    ``lane_f`` (3*_TL) are work arrays from the caller.
+    """
+    B = moments.shape[0]
+    x = stack_buffer(_XSIZE)
+    for i in range(_XSIZE):
+        x[i] = 0.0
+    for i in range(buf.shape[0]):
+        buf[i] = 0.0
+    # int state per lane: body (-1 none), direction, output pointer, outputs of
+    # the direction, steps, charts, status, needs a task, active, advanced
+    body = lane_i[0:_TL]
+    dirn = lane_i[_TL:2 * _TL]
+    ptr = lane_i[2 * _TL:3 * _TL]
+    nout = lane_i[3 * _TL:4 * _TL]
+    steps = lane_i[4 * _TL:5 * _TL]
+    charts = lane_i[5 * _TL:6 * _TL]
+    status = lane_i[6 * _TL:7 * _TL]
+    need = lane_i[7 * _TL:8 * _TL]
+    active = lane_i[8 * _TL:9 * _TL]
+    adv = lane_i[9 * _TL:10 * _TL]
+    scale_w = lane_f[0:_TL]
+    tlast = lane_f[_TL:2 * _TL]
+    sgn = lane_f[2 * _TL:3 * _TL]
+    for l in range(_TL):
+        body[l] = -1
+        need[l] = 1
+        active[l] = 0
+        lane_a[l] = 0.0
+        lane_a[_TL + l] = 0.0
+        lane_a[2 * _TL + l] = 0.0
+    if order > 1:
+        safety = math.exp(-0.7 / (order - 1))
+    else:
+        safety = 0.5
+    thr2 = threshold * threshold
+    next_body = 0
+    n_pos = idx_pos.shape[0]
+    n_neg = idx_neg.shape[0]
+    while True:
+        # tasks: the next direction of the lane's body, else the next body
+        n_active = 0
+        for l in range(_TL):
+            while need[l] != 0:
+                b = body[l]
+                if b >= 0:
+                    d = dirn[l] + 1
+                    started = False
+                    while d < 2 and status[l] == 0:
+                        cnt = n_pos if d == 0 else n_neg
+                        if cnt > 0:
+                            started = True
+                            break
+                        d += 1
+                    if started:
+                        dirn[l] = d
+                        if d == 0:
+                            sgn[l] = 1.0
+                            tlast[l] = abs(t[idx_pos[n_pos - 1]])
+                            nout[l] = n_pos
+                        else:
+                            sgn[l] = -1.0
+                            tlast[l] = abs(t[idx_neg[n_neg - 1]])
+                            nout[l] = n_neg
+                        for c in range(3):
+                            x[_XN + c * _TL + l] = 0.0
+                            x[_XW + c * _TL + l] = w0[b, c]
+                            x[_XNL + c * _TL + l] = 0.0
+                            x[_XWL + c * _TL + l] = 0.0
+                        for c in range(4):
+                            x[_XQ + c * _TL + l] = qref0[b, c]
+                        x[_XTH + l] = 0.0
+                        x[_XTC + l] = 0.0
+                        ptr[l] = 0
+                        need[l] = 0
+                        active[l] = 1
+                        break
+                    stats[b, 0] = steps[l]
+                    stats[b, 1] = charts[l]
+                    stats[b, 2] = status[l]
+                    body[l] = -1
+                    active[l] = 0
+                if next_body < B:
+                    b = next_body
+                    next_body += 1
+                    body[l] = b
+                    dirn[l] = -1
+                    steps[l] = 0
+                    charts[l] = 0
+                    status[l] = 0
+                    I1 = moments[b, 0]
+                    I2 = moments[b, 1]
+                    I3 = moments[b, 2]
+                    lane_a[l] = (I2 - I3) / I1
+                    lane_a[_TL + l] = (I3 - I1) / I2
+                    lane_a[2 * _TL + l] = (I1 - I2) / I3
+                    scale_w[l] = max(abs(w0[b, 0]), abs(w0[b, 1]), abs(w0[b, 2]))
+                else:
+                    need[l] = 0
+                    active[l] = 0
+                    # an idle lane integrates a body at rest (no NaN, no cost to the others)
+                    for c in range(3):
+                        x[_XN + c * _TL + l] = 0.0
+                        x[_XW + c * _TL + l] = 0.0
+            n_active += active[l]
+        if n_active == 0:
+            break
+        # Taylor coefficients of all lanes
+        for c in range(3):
+            for l in range(_TL):
+                buf[_CN + c * _TL + l] = x[_XN + c * _TL + l]
+                buf[_CW + c * _TL + l] = x[_XW + c * _TL + l]
+        _nb_series_lanes(lane_a, buf, order)
+        # step sizes and dense output, lane by lane
+        for l in range(_TL):
+            x[_XH + l] = 0.0
+            adv[l] = 0
+            if active[l] == 0:
+                continue
+            if dt > 0.0:
+                h = dt
+            else:
+                scale_n = max(1.0, abs(x[_XN + l]), abs(x[_XN + _TL + l]), abs(x[_XN + 2 * _TL + l]))
+                rho = math.inf
+                nanflag = False
+                for k in range(order - 1, order + 1):
+                    if k < 1:
+                        continue
+                    o = k * _TR + l
+                    xx = math.inf
+                    nrm = max(abs(buf[o]), abs(buf[o + _TL]), abs(buf[o + 2 * _TL]))
+                    if nrm != nrm:
+                        nanflag = True
+                    elif nrm > 0.0:
+                        xx = tol * scale_n / nrm
+                    nrm = max(abs(buf[o + 3 * _TL]), abs(buf[o + 4 * _TL]), abs(buf[o + 5 * _TL]))
+                    if nrm != nrm:
+                        nanflag = True
+                    elif nrm > 0.0:
+                        xx = min(xx, tol * scale_w[l] / nrm)
+                    if xx < math.inf:
+                        r = xx ** (1.0 / k)
+                        if r < rho:
+                            rho = r
+                h = safety * rho
+                if nanflag:
+                    h = math.nan
+                elif math.isinf(h):
+                    h = 2.0 * max(tlast[l] - abs(x[_XTH + l]), 0.0) + 1.0
+            steps[l] += 1
+            if not (h > 0.0) or math.isinf(h):
+                status[l] = STATUS_NONFINITE
+                need[l] = 1
+                continue
+            b = body[l]
+            sign = sgn[l]
+            L = nout[l]
+            while ptr[l] < L:
+                if dirn[l] == 0:
+                    j = idx_pos[ptr[l]]
+                else:
+                    j = idx_neg[ptr[l]]
+                theta = (t[j] - x[_XTH + l]) - x[_XTC + l]
+                if sign * theta > h:
+                    break
+                d0, d1, d2, e0, e1, e2 = _nb_lane_horner_delta(buf, l, order, theta)
+                nx = x[_XN + l] + (d0 + x[_XNL + l])
+                ny = x[_XN + _TL + l] + (d1 + x[_XNL + _TL + l])
+                nz = x[_XN + 2 * _TL + l] + (d2 + x[_XNL + 2 * _TL + l])
+                q0, q1, q2, q3 = _nb_quat_gibbs(
+                    x[_XQ + l], x[_XQ + _TL + l], x[_XQ + 2 * _TL + l], x[_XQ + 3 * _TL + l], nx, ny, nz
+                )
+                q_out[b, j, 0] = q0
+                q_out[b, j, 1] = q1
+                q_out[b, j, 2] = q2
+                q_out[b, j, 3] = q3
+                w_out[b, j, 0] = x[_XW + l] + (e0 + x[_XWL + l])
+                w_out[b, j, 1] = x[_XW + _TL + l] + (e1 + x[_XWL + _TL + l])
+                w_out[b, j, 2] = x[_XW + 2 * _TL + l] + (e2 + x[_XWL + 2 * _TL + l])
+                ptr[l] += 1
+            if ptr[l] >= L:
+                need[l] = 1
+                continue
+            x[_XH + l] = sign * h
+            adv[l] = 1
+        # compensated update of all lanes; a lane that does not advance (h = 0) is idle (at
+        # rest, state zero) or done with its task (its state is reloaded before it is used)
+        oo = order * _TR
+        for c in range(3):
+            for l in range(_TL):
+                x[_XDN + c * _TL + l] = buf[oo + _CN + c * _TL + l]
+                x[_XDW + c * _TL + l] = buf[oo + _CW + c * _TL + l]
+        for k in range(order - 1, 0, -1):
+            ok = k * _TR
+            ck = buf[ok:ok + _TR]
+            for l in range(_TL):
+                hl = x[_XH + l]
+                x[_XDN + l] = x[_XDN + l] * hl + ck[_CN + l]
+                x[_XDN + _TL + l] = x[_XDN + _TL + l] * hl + ck[_CN + _TL + l]
+                x[_XDN + 2 * _TL + l] = x[_XDN + 2 * _TL + l] * hl + ck[_CN + 2 * _TL + l]
+                x[_XDW + l] = x[_XDW + l] * hl + ck[_CW + l]
+                x[_XDW + _TL + l] = x[_XDW + _TL + l] * hl + ck[_CW + _TL + l]
+                x[_XDW + 2 * _TL + l] = x[_XDW + 2 * _TL + l] * hl + ck[_CW + 2 * _TL + l]
+        for c in range(3):
+            for l in range(_TL):
+                hl = x[_XH + l]
+                cur = x[_XN + c * _TL + l]
+                y = _nb_mul(x[_XDN + c * _TL + l], hl) + x[_XNL + c * _TL + l]
+                s = cur + y
+                z = s - cur
+                x[_XNL + c * _TL + l] = (cur - (s - z)) + (y - z)
+                x[_XN + c * _TL + l] = s
+                cur = x[_XW + c * _TL + l]
+                y = _nb_mul(x[_XDW + c * _TL + l], hl) + x[_XWL + c * _TL + l]
+                s = cur + y
+                z = s - cur
+                x[_XWL + c * _TL + l] = (cur - (s - z)) + (y - z)
+                x[_XW + c * _TL + l] = s
+        # time, chart changes and checks, lane by lane
+        for l in range(_TL):
+            if adv[l] == 0:
+                continue
+            hs = x[_XH + l]
+            th = x[_XTH + l]
+            s = th + hs
+            z = s - th
+            x[_XTC + l] += (th - (s - z)) + (hs - z)
+            x[_XTH + l] = s
+            n0 = x[_XN + l]
+            n1 = x[_XN + _TL + l]
+            n2 = x[_XN + 2 * _TL + l]
+            nn = n0 * n0 + n1 * n1 + n2 * n2
+            if nn > thr2:
+                q0, q1, q2, q3 = _nb_quat_gibbs(
+                    x[_XQ + l], x[_XQ + _TL + l], x[_XQ + 2 * _TL + l], x[_XQ + 3 * _TL + l], n0, n1, n2
+                )
+                x[_XQ + l] = q0
+                x[_XQ + _TL + l] = q1
+                x[_XQ + 2 * _TL + l] = q2
+                x[_XQ + 3 * _TL + l] = q3
+                d0, d1, d2 = _nb_chart(n0, n1, n2, x[_XNL + l], x[_XNL + _TL + l], x[_XNL + 2 * _TL + l])
+                x[_XNL + l] = d0
+                x[_XNL + _TL + l] = d1
+                x[_XNL + 2 * _TL + l] = d2
+                x[_XN + l] = 0.0
+                x[_XN + _TL + l] = 0.0
+                x[_XN + 2 * _TL + l] = 0.0
+                charts[l] += 1
+            wsum = x[_XW + l] + x[_XW + _TL + l] + x[_XW + 2 * _TL + l]
+            if not (math.isfinite(nn) and math.isfinite(wsum)):
+                status[l] = STATUS_NONFINITE
+                need[l] = 1
+            elif steps[l] >= max_steps:
+                status[l] = STATUS_MAX_STEPS
+                need[l] = 1
+
+
 if USE_NUMBA:  # pragma: no branch
     from numba import njit as _njit
 
+    _nb_mul = _njit(cache=True, nogil=True)(_nb_mul)  # no fastmath flags: never contracted
     _nb_series = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series)
-    _nb_attitude = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_attitude)
+    _nb_quat_gibbs = _njit(cache=True, nogil=True)(_nb_quat_gibbs)  # no contract, see its docstring
+    _nb_chart = _njit(cache=True, nogil=True)(_nb_chart)
     _nb_horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner)
     _nb_horner_delta = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner_delta)
     _nb_coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_coefficients)
     _nb_integrate = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate)
+    _nb_series_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series_lanes)
+    _nb_lane_horner_delta = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_lane_horner_delta)
+    _nb_integrate_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate_lanes)
 
 
 def coefficients_numba(moments, n0, w0, order):
@@ -790,8 +1229,14 @@ def coefficients_numba(moments, n0, w0, order):
     )
 
 
-def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold):
+def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold, lanes=None):
     """Compiled Taylor integration; same arguments and results as :func:`integrate_numpy` (float64 only).
+
+    ``lanes``: None (default) runs the lane kernel (``LANES_TAYLOR`` bodies
+    in lockstep, SIMD) when there are at least ``LANES_MIN_BODIES`` bodies,
+    else one body after the other; True or False forces one of the two.
+    Both take the same steps and give the same results (to round-off; bit
+    for bit when LLVM contracts the same multiply-adds in both).
 
     Runs the plain-Python version of the same code when numba is not used
     (slow; :func:`integrate_numpy` is the fallback actually used then).
@@ -808,8 +1253,18 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     q_out = np.zeros((B, T, 4))
     w_out = np.zeros((B, T, 3))
     stats = np.zeros((B, 3), dtype=np.int64)
-    _nb_integrate(
-        moments, w0, qref0, t, pos, neg, float(tol), int(order), float(dt) if dt is not None else -1.0,
-        int(max_steps), float(threshold), q_out, w_out, stats,
-    )
+    args = (moments, w0, qref0, t, pos, neg, float(tol), int(order), float(dt) if dt is not None else -1.0,
+            int(max_steps), float(threshold), q_out, w_out, stats)
+    if lanes is None:
+        lanes = USE_NUMBA and B >= LANES_MIN_BODIES
+    if lanes:
+        _nb_integrate_lanes(
+            *args,
+            np.zeros((int(order) + 1) * _TR),
+            np.zeros(3 * _TL),
+            np.zeros(10 * _TL, dtype=np.int64),
+            np.zeros(3 * _TL),
+        )
+    else:
+        _nb_integrate(*args)
     return q_out, w_out, stats

@@ -319,6 +319,10 @@ def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
     r"""Attitudes :math:`q_0\otimes q_\mathrm{rel}(t)` for relative motions starting at the identity.
 
     ``q_rel`` has shape (*batch_shape, T, 4); left invariance of the free body
-    makes this the motion from ``q0``.
+    makes this the motion from ``q0``. When every ``q0`` is the identity,
+    ``q_rel`` is returned as it is (the product would only copy it).
     """
-    return _qmul(problem.q0[..., None, :], q_rel)
+    q0 = problem.q0
+    if np.all(q0[..., 0] == 1.0) and not np.any(q0[..., 1:]):
+        return q_rel
+    return _qmul(q0[..., None, :], q_rel)

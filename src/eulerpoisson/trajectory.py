@@ -72,11 +72,13 @@ class Trajectory:
             raise InvalidInputError(
                 f"inconsistent trajectory shapes: t {self.t.shape}, quaternion {q.shape}, omega {self.omega.shape}"
             )
-        nrm = np.linalg.norm(q, axis=-1, keepdims=True)
+        nrm = np.sqrt(np.einsum("...i,...i->...", q, q))[..., None]
         if np.any(nrm == 0):
             raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
         # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
-        q = np.where(np.abs(nrm - 1.0) > 4 * np.finfo(float).eps, q / nrm, q)
+        off = np.abs(nrm - 1.0) > 4 * np.finfo(float).eps
+        if np.any(off):
+            q = np.where(off, q / nrm, q)
         if self.t.size < 2 or np.all(self.t[1:] >= self.t[:-1]):  # the usual case: no reordering needed
             self.quaternion = quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
         else:

@@ -72,7 +72,10 @@ class Trajectory:
             raise InvalidInputError(
                 f"inconsistent trajectory shapes: t {self.t.shape}, quaternion {q.shape}, omega {self.omega.shape}"
             )
-        nrm = np.sqrt(np.einsum("...i,...i->...", q, q))[..., None]
+        # a fixed summation order (an einsum or a reduction may sum in an order that depends on the
+        # memory layout, and then two equal arrays could be normalized differently)
+        w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+        nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
         if np.any(nrm == 0):
             raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
         # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)

@@ -84,3 +84,16 @@ def as_scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False
     if nonnegative and not v >= 0:
         raise InvalidInputError(f"{name} must be >= 0, got {x!r}")
     return v
+
+
+def as_bool(x, name: str) -> bool:
+    """A flag: ``bool`` or ``numpy.bool_`` only (a string such as ``"no"`` is truthy, so it is refused).
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not a boolean.
+    """
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    raise TypeError(f"{name} must be True or False, got {x!r} ({type(x).__name__})")

@@ -68,7 +68,7 @@ import operator
 
 import numpy as np
 
-from ._validate import as_float_array, as_scalar
+from ._validate import as_bool, as_float_array, as_scalar
 from .errors import InvalidInputError, SingularChartError
 
 __all__ = [
@@ -965,7 +965,7 @@ def quaternion_from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndar
     """
     axes, intrinsic = _parse_seq(seq)
     ang = as_float_array(angles, "angles", (3,))
-    if degrees:
+    if as_bool(degrees, "degrees"):
         ang = np.deg2rad(ang)
     qs = []
     for i, ax in enumerate(axes):
@@ -1062,7 +1062,7 @@ def euler_from_quaternion(seq: str, q, *, degrees: bool = False) -> np.ndarray:
     out = np.stack([_wrap_pi(t1), th2, _wrap_pi(t3)], -1)
     if intrinsic:
         out = out[..., ::-1]
-    return np.rad2deg(out) if degrees else out
+    return np.rad2deg(out) if as_bool(degrees, "degrees") else out
 
 
 # ---------------------------------------------------------------------------
@@ -2005,7 +2005,7 @@ class Attitude:
         -------
         ndarray, shape (..., 4)
         """
-        return _canonical(self._q) if canonical else self._q.copy()
+        return _canonical(self._q) if as_bool(canonical, "canonical") else self._q.copy()
 
     def as_gibbs(self) -> np.ndarray:
         """The paper's Gibbs vectors :math:`\\mathbf n = \\mathbf k\\tan(\\alpha/2)` (eq. 1.8).
@@ -2151,7 +2151,7 @@ class Attitude:
         """
         v = as_float_array(vectors, "vectors", (3,))
         R = self.as_matrix()
-        if inverse:
+        if as_bool(inverse, "inverse"):
             R = np.swapaxes(R, -1, -2)
         return np.einsum("...ij,...j->...i", R, v)
 

@@ -32,12 +32,58 @@ from .solvers import Method, MethodResult, Problem, compose_initial, register_me
 __all__ = ["Exact"]
 
 
+#: largest |Omega| |t| the closed form accepts (2^48, about 2.8e14 radians)
+MAX_PHASE = 2.0**48
+
+
+def _check_phase_range(problem: Problem) -> None:
+    r"""Refuse times at which float64 no longer determines the phase of the motion.
+
+    The frequencies of the motion (the elliptic :math:`\lambda` and the
+    precession rate, both of the order of :math:`|\boldsymbol\Omega|`) are
+    rounded numbers: a relative error of a few ulp becomes a phase error of
+    about :math:`4\varepsilon|\boldsymbol\Omega||t|`. Beyond
+    :math:`|\boldsymbol\Omega||t| = 2^{48}` that is more than a tenth of a
+    radian, and far beyond it any point of the orbit would be as good an
+    answer as another: an error instead of a silent guess.
+
+    Raises
+    ------
+    InvalidInputError
+        If :math:`|\boldsymbol\Omega_0||t| > 2^{48}` for some body and time.
+    """
+    from .errors import InvalidInputError
+
+    if problem.t.size == 0:
+        return
+    speed = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1))
+    tmax = float(np.max(np.abs(problem.t)))
+    with np.errstate(over="ignore"):
+        phase = speed * tmax
+    if np.any(phase > MAX_PHASE):
+        flat = np.reshape(phase, -1)
+        i = int(np.argmax(flat))
+        where = f" (body {tuple(int(k) for k in np.unravel_index(i, phase.shape))})" if phase.ndim else ""
+        raise InvalidInputError(
+            f"exact: |omega0| |t| = {flat[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad: at |t| = {tmax:.6g} "
+            f"the rounding of the frequencies (a few ulp) already shifts the phase of the motion by more than "
+            f"0.1 rad, so float64 cannot say where on its orbit the body is; use shorter times"
+        )
+
+
 @register_method
 class Exact(Method):
-    """Closed-form solution by Jacobi elliptic functions and Carlson's integrals.
+    r"""Closed-form solution by Jacobi elliptic functions and Carlson's integrals.
 
-    Accurate to a few ulps at any time, O(1) per output time, vectorized over
-    bodies and times; no options.
+    Accurate to a few ulps times :math:`|\boldsymbol\Omega||t|` (the
+    conditioning of the phase), O(1) per output time, vectorized over bodies
+    and times; no options.
+
+    Raises
+    ------
+    InvalidInputError
+        At times with :math:`|\boldsymbol\Omega_0||t| > 2^{48}`, where
+        float64 no longer determines the phase of the motion.
     """
 
     name = "exact"
@@ -48,6 +94,7 @@ class Exact(Method):
     def run(self, problem: Problem) -> MethodResult:
         from ._exact import exact_motion
 
+        _check_phase_range(problem)
         P = problem.principal_axes  # (*B, 3, 3), det +1
         Ip = problem.principal_moments
         Mp0 = np.einsum("...ji,...j->...i", P, problem.M0)

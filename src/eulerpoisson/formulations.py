@@ -112,7 +112,7 @@ from .attitude import (
     skew,
 )
 from .body import RigidBody
-from .errors import InvalidInputError
+from .errors import InvalidInputError, SingularChartError
 
 __all__ = [
     "Formulation",
@@ -885,17 +885,55 @@ class Formulation:
         return f"{type(self).__name__}(name={self.name!r}, dimension={self.dimension}, body={self.body!r})"
 
 
+#: largest |n| at which the Gibbs formulations evaluate their formulas (powers up to
+#: n^6 appear: 1e50 keeps them, and their differences, far from overflow and underflow)
+MAX_GIBBS_NORM = 1e50
+
+
+def _check_gibbs_norm(n, name: str) -> None:
+    """SingularChartError where |n| > MAX_GIBBS_NORM (a rotation within ~2e-50 rad of a half turn)."""
+    big = np.max(np.abs(n), axis=-1) if n.size else np.zeros(0)
+    if np.any(big > MAX_GIBBS_NORM / 2.0):
+        nrm = np.sqrt(np.sum((n / MAX_GIBBS_NORM) ** 2, axis=-1)) * MAX_GIBBS_NORM
+        worst = float(np.max(nrm))
+        if worst > MAX_GIBBS_NORM:
+            raise SingularChartError(
+                f"{name}: |n| = {worst:.3g} exceeds {MAX_GIBBS_NORM:.0e}: the rotation is within "
+                f"{2.0 / worst:.1e} rad of a half turn, the singularity of the Gibbs chart, where the "
+                f"formulas overflow; re-centre the chart (eulerpoisson.attitude.gibbs_chart) or use the "
+                f"'euler_poisson' formulation"
+            )
+
+
 class _GibbsFormulation(Formulation):
-    """Common parts of the formulations whose first block is n."""
+    r"""Common parts of the formulations whose first block is n.
+
+    The formulas are evaluated for :math:`|\mathbf n|\le 10^{50}` only
+    (:data:`MAX_GIBBS_NORM`); beyond, a
+    :class:`~eulerpoisson.errors.SingularChartError`. The attitude
+    conversions (:meth:`gibbs`, :meth:`quaternion`, :meth:`matrix`) take any
+    finite n. Near the half turn the chart is ill-conditioned: a state
+    :math:`\delta` rad from it has :math:`|\mathbf n|\approx 2/\delta`, and
+    quantities computed from :math:`(\mathbf n, \boldsymbol\pi)` or
+    :math:`(\mathbf n, \mathbf m)` carry relative errors up to about
+    :math:`\varepsilon|\mathbf n|` (measured :math:`\varepsilon|\mathbf n|/10`
+    for the energy; :math:`(\mathbf n, \boldsymbol\Omega)` keeps full
+    accuracy); re-centre the chart where that matters.
+    """
+
+    def _check(self, state, what="state"):
+        x = super()._check(state, what)
+        _check_gibbs_norm(x[..., 0:3], f"{what} of the {self.name!r} formulation")
+        return x
 
     def gibbs(self, state) -> np.ndarray:
-        return self._check(state)[..., 0:3].copy()
+        return Formulation._check(self, state)[..., 0:3].copy()
 
     def quaternion(self, state) -> np.ndarray:
-        return quaternion_from_gibbs(self._check(state)[..., 0:3])
+        return quaternion_from_gibbs(Formulation._check(self, state)[..., 0:3])
 
     def matrix(self, state) -> np.ndarray:
-        return matrix_from_gibbs(self._check(state)[..., 0:3])
+        return matrix_from_gibbs(Formulation._check(self, state)[..., 0:3])
 
     def to_common(self, state):
         x = self._check(state)
@@ -907,6 +945,7 @@ class _GibbsFormulation(Formulation):
 
     def _common_in(self, q, omega):
         n = gibbs_from_quaternion(q)
+        _check_gibbs_norm(n, f"q for the {self.name!r} formulation")
         w = as_float_array(omega, "omega", (3,))
         n, w = np.broadcast_arrays(n, w)
         return n, w

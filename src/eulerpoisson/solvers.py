@@ -234,14 +234,22 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
                 f"attitude0 must be a unit quaternion (w, x, y, z); its norm is {float(nrm.ravel()[np.argmax(np.abs(nrm.ravel() - 1.0))]):.9g}"
             )
         q0 = _as_quaternion(q0, "attitude0")
+    name, v0 = ("omega0", omega0) if omega0 is not None else ("m0", m0)
+    v0 = as_float_array(v0, name, (3,))
+    try:
+        shape = np.broadcast_shapes(q0.shape[:-1], v0.shape[:-1], body.batch_shape)
+    except ValueError:
+        raise InvalidInputError(
+            f"the batch shapes do not broadcast: body {body.batch_shape} (inertia {body.inertia.shape}), "
+            f"{name} {v0.shape[:-1]} (array {v0.shape}), attitude0 {q0.shape[:-1]} (array {q0.shape}); "
+            f"leading axes must broadcast as in numpy"
+        ) from None
     if omega0 is not None:
-        w0 = as_float_array(omega0, "omega0", (3,))
+        w0 = v0
     else:
-        m = as_float_array(m0, "m0", (3,))
         R0 = Attitude(q0).as_matrix()
-        M = np.einsum("...ji,...j->...i", R0, m)
+        M = np.einsum("...ji,...j->...i", R0, v0)
         w0 = np.einsum("...ij,...j->...i", body.inertia_inv, M)
-    shape = np.broadcast_shapes(q0.shape[:-1], w0.shape[:-1], body.batch_shape)
     q0 = np.broadcast_to(q0, shape + (4,)).copy()
     w0 = np.broadcast_to(w0, shape + (3,)).copy()
     return Problem(body=body, q0=q0, omega0=w0, t=times)

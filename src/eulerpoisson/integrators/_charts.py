@@ -487,6 +487,38 @@ def check_threshold(value) -> float:
     return v
 
 
+def check_step_budget(method: str, t, steps_per_unit_time: float, max_steps: int, hint: str) -> None:
+    r"""Refuse a run that needs more than ``max_steps`` steps before it starts.
+
+    The number of steps is estimated as ``steps_per_unit_time`` times the time
+    to cover, :math:`\max(t, 0) + \max(-t, 0)` (both branches start at
+    0). A non-finite estimate (an overflowing rate or time) is refused too.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the method, the estimate, ``max_steps`` and ``hint``.
+    """
+    t = np.asarray(t, dtype=float)
+    if t.size == 0:
+        return
+    span = max(float(np.max(t)), 0.0) + max(-float(np.min(t)), 0.0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        need = span * float(steps_per_unit_time)
+    if span > 0 and not (need <= max_steps):  # also catches inf and nan
+        raise InvalidInputError(
+            f"{method}: reaching |t| = {span:.6g} needs about {need:.3g} steps, more than max_steps={max_steps}; "
+            f"{hint}"
+        )
+
+
+def check_max_steps(method: str, value) -> int:
+    """``max_steps`` option: an integer >= 1 (not a bool)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidInputError(f"{method}: max_steps must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
 def run_fixed_step(t, dt, state0, advance, output):
     r"""Drive a one-step map through the output times with fixed steps.
 

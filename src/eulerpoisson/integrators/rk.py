@@ -101,6 +101,14 @@ def _rhs_gibbs(moments):
     return f
 
 
+class _StepBudgetExhausted(Exception):
+    """Raised inside the right-hand side when ``max_steps`` is used up."""
+
+
+#: right-hand side evaluations allowed per step of ``max_steps`` (DOP853 uses 12 per step)
+_NFEV_PER_STEP = 16
+
+
 @register_method
 class RK(Method):
     r"""``scipy.integrate.solve_ivp`` on the quaternion or Gibbs-vector formulation.
@@ -121,6 +129,11 @@ class RK(Method):
     chart_threshold : float
         ``"gibbs"`` only: re-centre the chart when :math:`|\mathbf n|`
         reaches it (default 1, > 0).
+    max_steps : int
+        Per body (default 10^7). Refused up front when the times need at
+        least :math:`|\boldsymbol\Omega||t|/(8\pi)` steps more than that;
+        during the run, 16 evaluations of the right-hand side count as one
+        step. Exhausted: :class:`~eulerpoisson.errors.EulerPoissonError`.
 
     :meth:`nominal_order` is the order of the chosen integrator (the highest
     order for the variable-order BDF and LSODA).
@@ -134,6 +147,7 @@ class RK(Method):
         "rtol": None,
         "atol": None,
         "chart_threshold": ch.DEFAULT_CHART_THRESHOLD,
+        "max_steps": 10_000_000,
     }
     order = 8
     refine = "tol"
@@ -163,6 +177,7 @@ class RK(Method):
         if thr == 0:
             raise InvalidInputError("rk: chart_threshold must be > 0 (the chart event is |n| = chart_threshold)")
         cfg["chart_threshold"] = thr
+        cfg["max_steps"] = ch.check_max_steps("rk", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of the configured scipy integrator."""
@@ -195,8 +210,16 @@ class RK(Method):
         stats = {"integrator": cfg["integrator"], "formulation": cfg["formulation"], "nfev": 0, "njev": 0,
                  "steps": 0, "chart_changes": 0}
         t = problem.t
+        if B:
+            # an explicit Runge-Kutta step turns the body by at most a few radians (stability of
+            # the oscillating solution): at least |Omega| |t| / (8 pi) steps, checked up front
+            with np.errstate(over="ignore"):
+                wmax = float(np.max(np.sqrt(ch.dot(w0, w0))))
+            ch.check_step_budget("rk", t, wmax / (8.0 * math.pi), cfg["max_steps"],
+                                 "raise max_steps or shorten the times")
         branches = [np.flatnonzero(t >= 0), np.flatnonzero(t < 0)]
         for b in range(B):
+            stats["_nfev_body"] = 0  # max_steps is per body, both branches together
             for idx in branches:
                 if idx.size == 0:
                     continue
@@ -206,6 +229,7 @@ class RK(Method):
                     q, w = self._solve_gibbs(q0[:, b], w0[:, b], moments[:, b], t[idx], stats)
                 qout[:, b, idx] = q
                 wout[:, b, idx] = w
+        stats.pop("_nfev_body", None)
         q, w = frame.from_principal(qout, wout)
         q = np.moveaxis(q, 0, -1).reshape(bshape + (T, 4))
         w = np.moveaxis(w, 0, -1).reshape(bshape + (T, 3))
@@ -214,13 +238,40 @@ class RK(Method):
     def _call(self, f, t0, t1, y0, rtol, atol, stats, events=None):
         from scipy.integrate import solve_ivp
 
-        sol = solve_ivp(f, (t0, t1), y0, method=self.config["integrator"], rtol=rtol, atol=atol,
-                        dense_output=True, events=events)
+        max_steps = self.config["max_steps"]
+        budget = _NFEV_PER_STEP * max_steps  # right-hand side evaluations allowed for this body
+        count = [stats.get("_nfev_body", 0)]
+
+        def g(t, y):
+            count[0] += 1
+            if count[0] > budget:
+                raise _StepBudgetExhausted
+            return f(t, y)
+
+        with np.errstate(over="ignore", invalid="ignore"):
+            try:
+                sol = solve_ivp(g, (t0, t1), y0, method=self.config["integrator"], rtol=rtol, atol=atol,
+                                dense_output=True, events=events)
+            except _StepBudgetExhausted:
+                raise EulerPoissonError(
+                    f"rk: max_steps={max_steps} exhausted ({budget} evaluations of the right-hand side) before "
+                    f"t = {t1:.6g}; raise max_steps or tol, or shorten the times"
+                ) from None
+        stats["_nfev_body"] = count[0]
+        if not np.all(np.isfinite(sol.y)):
+            raise EulerPoissonError(
+                f"rk: the state became non-finite before t = {t1:.6g} (overflow: too large angular velocity "
+                f"or Gibbs vector); use smaller values or formulation='quaternion'"
+            )
         stats["nfev"] += int(sol.nfev)
         stats["njev"] += int(sol.njev)
         stats["steps"] += max(len(sol.t) - 1, 0)
         if sol.status == -1:
-            raise EulerPoissonError(f"rk: solve_ivp ({self.config['integrator']}) failed: {sol.message}")
+            hint = ""
+            if self.config["formulation"] == "gibbs":
+                hint = (f" (formulation='gibbs': |n| grows without bound near a half turn unless the chart is "
+                        f"changed; chart_threshold={self.config['chart_threshold']:g})")
+            raise EulerPoissonError(f"rk: solve_ivp ({self.config['integrator']}) failed: {sol.message}{hint}")
         return sol
 
     def _solve_quaternion(self, q0, w0, moments, times, stats):
@@ -238,7 +289,8 @@ class RK(Method):
 
     def _solve_gibbs(self, q0, w0, moments, times, stats):
         rtol, atol = self._tolerances(w0, 3)
-        thr2 = self.config["chart_threshold"] ** 2
+        thr = self.config["chart_threshold"]
+        thr2 = thr * thr  # float: inf for a huge threshold (no chart change), no OverflowError
         f = _rhs_gibbs(moments)
 
         def event(t, y):

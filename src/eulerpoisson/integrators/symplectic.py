@@ -482,6 +482,10 @@ class Symplectic(Method):
         (default 1, a 90° rotation; 0 re-centres before every step, which
         makes the method a Cayley-chart Lie-group method that is no longer
         symplectic). Gauss with ``variables="gibbs"`` only.
+    max_steps : int
+        Most steps per body (default 10^8): the number of fixed steps the
+        output times need is known before the run, and a larger one is
+        refused with :class:`~eulerpoisson.errors.InvalidInputError`.
 
     The nominal order depends on the scheme: :meth:`nominal_order`.
 
@@ -498,6 +502,7 @@ class Symplectic(Method):
         "dt": None,
         "max_iter": 100,
         "chart_threshold": ch.DEFAULT_CHART_THRESHOLD,
+        "max_steps": 100_000_000,
     }
     order = 4
     refine = "dt"
@@ -525,6 +530,7 @@ class Symplectic(Method):
         if isinstance(mi, bool) or not isinstance(mi, (int, np.integer)) or mi < 1:
             raise InvalidInputError(f"symplectic: max_iter must be an integer >= 1, got {mi!r}")
         cfg["chart_threshold"] = ch.check_threshold(cfg["chart_threshold"])
+        cfg["max_steps"] = ch.check_max_steps("symplectic", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of convergence of the configured scheme (2, 4 or 6)."""
@@ -549,9 +555,13 @@ class Symplectic(Method):
         inv_m = 1.0 / moments
         dt = cfg["dt"]
         if dt is None:
-            wmax = float(np.max(np.sqrt(ch.dot(w0, w0)))) if B else 0.0
+            with np.errstate(over="ignore"):
+                wmax = float(np.max(np.sqrt(ch.dot(w0, w0)))) if B else 0.0
             dt = DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
         dt = float(dt)
+        if B:
+            ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
+                                 "raise max_steps or dt, or shorten the times")
         scheme = cfg["scheme"]
         stats = {"scheme": scheme, "dt": dt}
         compiled = _k.USE_NUMBA and B > 0 and (not scheme.startswith("gauss") or cfg["variables"] == "quaternion")

@@ -156,3 +156,41 @@ def test_gibbs_formulations_near_the_half_turn_lose_only_what_the_chart_loses(na
         assert 1.9 / delta < nn < 2.1 / delta
         err = abs(f.hamiltonian(s) / E - 1)
         assert err <= 4 * np.finfo(float).eps * nn, (delta, err)
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda at, A: at.quaternion_multiply([[1.0, 0, 0, 0]] * 2, [[1.0, 0, 0, 0]] * 3), r"p \(2, 4\), q \(3, 4\)"),
+        (lambda at, A: at.gibbs_compose([[0, 0, 1.0]] * 2, [[0, 0, 1.0]] * 3), r"n1 \(2, 3\), n2 \(3, 3\)"),
+        (lambda at, A: at.gibbs_rate_from_omega([[0, 0, 1.0]] * 2, [[0, 0, 1.0]] * 3), r"n \(2, 3\), omega \(3, 3\)"),
+        (lambda at, A: at.omega_from_gibbs_rate([[0, 0, 1.0]] * 2, [[0, 0, 1.0]] * 3), r"n \(2, 3\), ndot \(3, 3\)"),
+        (lambda at, A: at.gibbs_chart([[1.0, 0, 0, 0]] * 2, [[1.0, 0, 0, 0]] * 3), r"q \(2, 4\), reference \(3, 4\)"),
+        (lambda at, A: at.quaternion_from_chart([[1.0, 0, 0, 0]] * 2, [[0, 0, 1.0]] * 3), r"reference \(2, 4\), n \(3, 3\)"),
+        (lambda at, A: A.identity(2) * A.identity(3), r"self \(2, 4\), other \(3, 4\)"),
+        (lambda at, A: A.identity(2).angle_to(A.identity(3)), r"self \(2, 4\), other \(3, 4\)"),
+    ],
+)
+def test_attitude_functions_name_the_shapes_that_do_not_broadcast(call, match):
+    import eulerpoisson.attitude as at
+
+    with pytest.raises(InvalidInputError, match="batch shapes do not broadcast: " + match):
+        call(at, Attitude)
+
+
+def test_batch_shapes_of_the_factories():
+    assert Attitude.identity((2, 3)).as_quaternion().shape == (2, 3, 4)
+    assert Attitude.random(np.int64(5), rng=0).as_quaternion().shape == (5, 4)
+    with pytest.raises(TypeError, match="shape must be an int or a tuple of ints, got 2.5"):
+        Attitude.identity(2.5)
+    with pytest.raises(TypeError, match="shape must be an int or a tuple of ints, got True"):
+        Attitude.random(True)
+    with pytest.raises(InvalidInputError, match=r"shape entries must be >= 0, got \(2, -1\)"):
+        Attitude.random((2, -1))
+
+
+@pytest.mark.parametrize("key, value", [("tol", 2.0), ("tol", 1e-30), ("rtol", 1.0), ("rtol", 1e-15)])
+def test_rk_relative_tolerances_scipy_would_change_are_refused(key, value):
+    with pytest.raises(InvalidInputError, match=rf"rk: {key} must be in \[2.22e-14, 1\)"):
+        solve(I123, [1.0], omega0=W0, method="rk", **{key: value})
+    solve(I123, [1.0], omega0=W0, method="rk", tol=1e-13)  # the smallest tolerance of the benchmarks

@@ -97,3 +97,45 @@ def as_bool(x, name: str) -> bool:
     if isinstance(x, (bool, np.bool_)):
         return bool(x)
     raise TypeError(f"{name} must be True or False, got {x!r} ({type(x).__name__})")
+
+
+def check_broadcast(**arrays) -> tuple[int, ...]:
+    """Broadcast batch shape of arrays whose last axis is a vector (quaternion, Gibbs vector...).
+
+    ``check_broadcast(p=p, q=q)`` returns ``np.broadcast_shapes(p.shape[:-1], q.shape[:-1])``.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming every argument with its shape when the batch shapes do not broadcast.
+    """
+    try:
+        return np.broadcast_shapes(*(np.shape(a)[:-1] for a in arrays.values()))
+    except ValueError:
+        desc = ", ".join(f"{k} {np.shape(a)}" for k, a in arrays.items())
+        raise InvalidInputError(
+            f"batch shapes do not broadcast: {desc} (leading axes must broadcast as in numpy)"
+        ) from None
+
+
+def as_shape(shape, name: str = "shape") -> tuple[int, ...]:
+    """A batch shape: a non-negative int or a sequence of them (not bools, not floats).
+
+    Raises
+    ------
+    TypeError
+        If ``shape`` is not an int or a sequence of ints.
+    InvalidInputError
+        If an entry is negative.
+    """
+    items = (shape,) if isinstance(shape, (int, np.integer)) and not isinstance(shape, (bool, np.bool_)) else shape
+    try:
+        items = tuple(items)
+    except TypeError:
+        raise TypeError(f"{name} must be an int or a tuple of ints, got {shape!r}") from None
+    for k in items:
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise TypeError(f"{name} must be an int or a tuple of ints, got {shape!r}")
+        if k < 0:
+            raise InvalidInputError(f"{name} entries must be >= 0, got {shape!r}")
+    return tuple(int(k) for k in items)

@@ -68,7 +68,7 @@ import operator
 
 import numpy as np
 
-from ._validate import as_bool, as_float_array, as_scalar
+from ._validate import as_bool, as_float_array, as_scalar, as_shape, check_broadcast
 from .errors import InvalidInputError, SingularChartError
 
 __all__ = [
@@ -285,6 +285,7 @@ def quaternion_multiply(p, q) -> np.ndarray:
     """
     p = as_float_array(p, "p", (4,))
     q = as_float_array(q, "q", (4,))
+    check_broadcast(p=p, q=q)
     return _qmul(p, q)
 
 
@@ -1346,6 +1347,7 @@ def gibbs_compose(n1, n2) -> np.ndarray:
     """
     n1 = as_float_array(n1, "n1", (3,))
     n2 = as_float_array(n2, "n2", (3,))
+    check_broadcast(n1=n1, n2=n2)
     m1 = np.max(np.abs(n1), -1)
     m2 = np.max(np.abs(n2), -1)
     s1 = np.where(m1 > 1.0, _pow2_below(np.maximum(m1, 1.0)), 1.0)
@@ -1424,6 +1426,7 @@ def gibbs_chart(q, reference) -> np.ndarray:
     """
     q = _as_quaternion(q)
     q0 = _as_quaternion(reference, "reference")
+    check_broadcast(q=q, reference=q0)
     rel = _qmul(q0 * _CONJ, q)
     w = rel[..., 0]
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
@@ -1461,6 +1464,7 @@ def quaternion_from_chart(reference, n) -> np.ndarray:
     """
     q0 = _as_quaternion(reference, "reference")
     n = as_float_array(n, "n", (3,))
+    check_broadcast(reference=q0, n=n)
     return _qmul(q0, _quaternion_from_gibbs(n))
 
 
@@ -1594,6 +1598,7 @@ def omega_from_gibbs_rate(n, ndot) -> np.ndarray:
     """
     n = as_float_array(n, "n", (3,))
     nd = as_float_array(ndot, "ndot", (3,))
+    check_broadcast(n=n, ndot=nd)
     return 2.0 * np.einsum("...ji,...j->...i", _A(n), nd)
 
 
@@ -1622,6 +1627,7 @@ def gibbs_rate_from_omega(n, omega) -> np.ndarray:
     """
     n = as_float_array(n, "n", (3,))
     w = as_float_array(omega, "omega", (3,))
+    check_broadcast(n=n, omega=w)
     n, w = np.broadcast_arrays(n, w)
     return 0.5 * (w + np.cross(n, w) + np.sum(n * w, -1)[..., None] * n)
 
@@ -1785,7 +1791,7 @@ class Attitude:
         -------
         Attitude
         """
-        shape = (shape,) if isinstance(shape, (int, np.integer)) else tuple(shape)
+        shape = as_shape(shape)
         q = np.zeros(shape + (4,))
         q[..., 0] = 1.0
         return cls(q)
@@ -1806,7 +1812,7 @@ class Attitude:
         Attitude
         """
         rng = np.random.default_rng(rng)
-        shape = (shape,) if isinstance(shape, (int, np.integer)) else tuple(shape)
+        shape = as_shape(shape)
         return cls(rng.standard_normal(shape + (4,)))
 
     @classmethod
@@ -2118,6 +2124,7 @@ class Attitude:
         """``a * b``: the rotation :math:`R_aR_b` (apply ``b`` first); batch shapes broadcast."""
         if not isinstance(other, Attitude):
             return NotImplemented
+        check_broadcast(self=self._q, other=other._q)
         return Attitude(_qmul(self._q, other._q))
 
     __matmul__ = __mul__
@@ -2186,6 +2193,7 @@ class Attitude:
             If ``other`` is not an Attitude.
         """
         other = _check_attitude(other)
+        check_broadcast(self=self._q, other=other._q)
         rel = _qmul(self._q * _CONJ, other._q)
         return 2.0 * np.arctan2(_norm(rel[..., 1:]), np.abs(rel[..., 0]))
 

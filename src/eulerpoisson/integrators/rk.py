@@ -105,6 +105,9 @@ class _StepBudgetExhausted(Exception):
     """Raised inside the right-hand side when ``max_steps`` is used up."""
 
 
+#: smallest relative tolerance scipy's solve_ivp honours (100 machine epsilons)
+_RTOL_MIN = 100 * np.finfo(float).eps
+
 #: right-hand side evaluations allowed per step of ``max_steps`` (DOP853 uses 12 per step)
 _NFEV_PER_STEP = 16
 
@@ -173,6 +176,11 @@ class RK(Method):
                 raise InvalidInputError(f"rk: {key} must be a positive number, got {v!r}")
             if not (math.isfinite(float(v)) and float(v) > 0):
                 raise InvalidInputError(f"rk: {key} must be a finite number > 0, got {v!r}")
+            if key != "atol" and not (_RTOL_MIN <= float(v) < 1.0):
+                raise InvalidInputError(
+                    f"rk: {key} must be in [{_RTOL_MIN:.3g}, 1) (scipy's solve_ivp raises a smaller relative "
+                    f"tolerance to 100 machine epsilons), got {v!r}"
+                )
         thr = ch.check_threshold(cfg["chart_threshold"])
         if thr == 0:
             raise InvalidInputError("rk: chart_threshold must be > 0 (the chart event is |n| = chart_threshold)")

@@ -286,6 +286,13 @@ def test_overwrite_and_existing_output(tmp_path):
     solve_to_file(I123, (0.0, 2.0, 21), path, omega0=W0, progress=False, overwrite=True)
     assert _open(path).sizes["time"] == 21
     assert sorted(p.name for p in tmp_path.iterdir()) == ["o.zarr"]
+    # overwrite replaces earlier results only, never a folder of something else
+    other = tmp_path / "mine"
+    other.mkdir()
+    (other / "thesis.tex").write_text("precious")
+    with pytest.raises(FileExistsError, match="refusing to replace .*mine: it is a folder but not a Zarr store"):
+        solve_to_file(I123, (0.0, 1.0, 11), other, omega0=W0, progress=False, overwrite=True)
+    assert (other / "thesis.tex").read_text() == "precious"
 
 
 def test_work_folder_without_state_is_discarded(tmp_path):

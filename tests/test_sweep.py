@@ -483,3 +483,17 @@ def test_plot_random_atlas(tmp_path):
                   output__path=str(tmp_path / "r2.zarr"))
     with pytest.raises(InvalidInputError, match="only for one body"):
         plot_atlas(load_sweep(run_sweep(cfg2, progress=False)), tmp_path / "no.png")
+
+
+def test_overwrite_never_deletes_a_folder_that_is_not_a_store(tmp_path, monkeypatch):
+    target = tmp_path / "data"
+    target.mkdir()
+    (target / "notes.txt").write_text("keep me")
+
+    def boom(*a, **k):  # the refusal must come before any work
+        raise AssertionError("computed before refusing")
+
+    monkeypatch.setattr(sweep, "_compute_chunk", boom)
+    with pytest.raises(FileExistsError, match="refusing to replace .*data: it is a folder but not a Zarr store"):
+        run_sweep(config(tmp_path, output__path=str(target)), progress=False, overwrite=True)
+    assert (target / "notes.txt").read_text() == "keep me"

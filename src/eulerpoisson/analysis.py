@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validate import as_float_array
+from .body import _as_bool, _check_moments
 from .errors import InvalidInputError
 
 __all__ = ["elliptic_parameters", "momentum_period", "tennis_racket_half_period", "flip_times"]
@@ -34,9 +35,11 @@ def elliptic_parameters(inertia, M0) -> dict:
     Parameters
     ----------
     inertia : array_like, shape (3,)
-        Principal moments, distinct.
+        Principal moments, distinct, positive and normal floats (checked as
+        :class:`~eulerpoisson.RigidBody` checks them; the triangle inequality
+        is not required, so the often-quoted (3, 5, 9) is accepted).
     M0 : array_like, shape (3,)
-        Body angular momentum in the principal frame.
+        Body angular momentum in the principal frame, finite.
 
     Returns
     -------
@@ -48,54 +51,99 @@ def elliptic_parameters(inertia, M0) -> dict:
 
     Raises
     ------
+    InvalidInertiaError
+        A moment that is not > 0, or below the smallest normal float64.
     InvalidInputError
-        Two equal moments (a symmetric body has no elliptic modulus: the
-        motion is a uniform precession), or a momentum exactly on the
-        separatrix or zero.
+        Wrong shapes, NaN or infinite values; two equal moments (a
+        symmetric body has no elliptic modulus: the motion is a uniform
+        precession); a momentum exactly on the separatrix or zero; or a
+        rate :math:`\lambda` (or moments spanning a range) beyond float64.
+
+    Notes
+    -----
+    :math:`k^2` is homogeneous of degree 0 in :math:`\mathbf M` and in
+    :math:`I`, and :math:`\lambda` scales as :math:`|\mathbf M|/I`. Both are
+    computed with the moments and the momentum scaled by powers of two (to
+    about 1, exactly: ordinary inputs give the same bits as without scaling)
+    and :math:`\lambda` is scaled back, so momenta such as :math:`10^{200}`
+    or :math:`10^{-200}` neither overflow nor underflow.
     """
     I = as_float_array(inertia, "inertia", (3,))
     M = as_float_array(M0, "M0", (3,))
     if I.ndim != 1 or M.ndim != 1:
-        raise InvalidInputError("elliptic_parameters takes one body: inertia and M0 of shape (3,)")
+        raise InvalidInputError(
+            f"elliptic_parameters takes one body: inertia and M0 of shape (3,), got shapes {I.shape} and {M.shape}"
+        )
+    _check_moments(I, "inertia", triangle=False)
     order = np.argsort(I)
-    I1, I2, I3 = I[order]
-    M = M[order]
-    if not (I1 < I2 < I3):
+    if not (I[order[0]] < I[order[1]] < I[order[2]]):
         raise InvalidInputError(f"elliptic_parameters needs three distinct principal moments, got {I.tolist()}")
-    L2 = float(M @ M)
-    if L2 == 0:
+    if not np.any(M != 0):
         raise InvalidInputError("M0 is zero: the body is at rest")
+    # exact power-of-two scaling: I -> I 2**-eI, M -> M 2**-eM (lam is scaled back below)
+    eI = int(np.frexp(np.max(I))[1])
+    eM = int(np.frexp(np.max(np.abs(M)))[1])
+    with np.errstate(under="ignore"):
+        I1, I2, I3 = np.ldexp(I[order], -eI)
+        M = np.ldexp(M[order], -eM)
     I_ = np.array([I1, I2, I3])
-    d2 = float(np.sum(M**2 * (I2 / I_ - 1.0)))  # 2 E I2 - L^2
-    d1 = float(np.sum(M**2 * (1.0 - I1 / I_)))  # L^2 - 2 E I1 >= 0
-    d3 = float(np.sum(M**2 * (I3 / I_ - 1.0)))  # 2 E I3 - L^2 >= 0
-    if d2 == 0:
-        raise InvalidInputError("M0 lies on the separatrix (L^2 = 2 E I2): the period is infinite")
-    if d2 > 0:  # circulation about the axis of smallest moment
-        k2 = (I3 - I2) * d1 / ((I2 - I1) * d3)
-        k2c = (I3 - I1) * d2 / ((I2 - I1) * d3)
-        lam = np.sqrt((I2 - I1) * d3 / (I1 * I2 * I3))
-        axis = int(order[0])
-    else:
-        k2 = (I2 - I1) * d3 / ((I3 - I2) * d1)
-        k2c = (I3 - I1) * (-d2) / ((I3 - I2) * d1)
-        lam = np.sqrt((I3 - I2) * d1 / (I1 * I2 * I3))
-        axis = int(order[2])
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore", under="ignore"):
+        d2 = float(np.sum(M**2 * (I2 / I_ - 1.0)))  # 2 E I2 - L^2
+        d1 = float(np.sum(M**2 * (1.0 - I1 / I_)))  # L^2 - 2 E I1 >= 0
+        d3 = float(np.sum(M**2 * (I3 / I_ - 1.0)))  # 2 E I3 - L^2 >= 0
+        if d2 == 0:
+            raise InvalidInputError("M0 lies on the separatrix (L^2 = 2 E I2): the period is infinite")
+        if d2 > 0:  # circulation about the axis of smallest moment
+            k2 = (I3 - I2) * d1 / ((I2 - I1) * d3)
+            k2c = (I3 - I1) * d2 / ((I2 - I1) * d3)
+            lam = np.sqrt((I2 - I1) * d3 / (I1 * I2 * I3))
+            axis = int(order[0])
+        else:
+            k2 = (I2 - I1) * d3 / ((I3 - I2) * d1)
+            k2c = (I3 - I1) * (-d2) / ((I3 - I2) * d1)
+            lam = np.sqrt((I3 - I2) * d1 / (I1 * I2 * I3))
+            axis = int(order[2])
+        lam = np.ldexp(lam, eM - eI)  # lambda is homogeneous of degree 1 in M and -1 in I
+    # a subnormal lambda has lost its relative precision: refused like an infinite one
+    if not (np.isfinite(k2) and np.isfinite(k2c) and np.isfinite(lam) and lam >= np.finfo(float).tiny):
+        raise InvalidInputError(
+            f"elliptic_parameters: k^2 = {k2!r}, 1 - k^2 = {k2c!r}, lambda = {float(lam)!r} are not representable "
+            f"in float64 for inertia {I.tolist()} and M0 {np.asarray(M0, float).tolist()} (moments spanning too "
+            "wide a range, or |M0|/I out of range); rescale the units"
+        )
     return {"k2": k2, "k2c": k2c, "lam": float(lam), "axis": axis, "order": order}
 
 
 def momentum_period(inertia, M0) -> float:
     r"""Period :math:`4K(k)/\lambda` of the body angular momentum :math:`\mathbf M(t)`.
 
+    Parameters
+    ----------
+    inertia : array_like, shape (3,)
+        Principal moments (see :func:`elliptic_parameters`).
+    M0 : array_like, shape (3,)
+        Body angular momentum in the principal frame.
+
+    Returns
+    -------
+    float
+
     Raises
     ------
-    InvalidInputError
-        See :func:`elliptic_parameters`.
+    InvalidInertiaError, InvalidInputError
+        See :func:`elliptic_parameters`; also a period that overflows float64.
     """
     from scipy.special import ellipkm1
 
     p = elliptic_parameters(inertia, M0)
-    return float(4.0 * ellipkm1(p["k2c"]) / p["lam"])
+    with np.errstate(over="ignore"):
+        T = float(4.0 * ellipkm1(p["k2c"]) / p["lam"])
+    if not np.isfinite(T):
+        raise InvalidInputError(
+            f"the period 4 K(k)/lambda overflows float64 (lambda = {p['lam']!r}, 1 - k^2 = {p['k2c']!r}); "
+            "rescale the units"
+        )
+    return T
 
 
 def tennis_racket_half_period(inertia, M0) -> float:
@@ -111,29 +159,62 @@ def flip_times(traj, component: int = 1, *, refine: bool = True) -> np.ndarray:
     the closed-form solution (so they are accurate to round-off, not to the
     sampling step).
 
+    Exact zeros: a flip is a change of sign between consecutive *nonzero*
+    samples. When exactly-zero samples lie between two samples of opposite
+    sign, that is one flip, placed at the zero sample (at the middle of a
+    run of several zeros) before refinement. Zeros before the first or
+    after the last nonzero sample, and zeros between samples of the same
+    sign (a touch), are not flips.
+
     Parameters
     ----------
     traj : Trajectory
         A single-body trajectory with increasing times.
     component : int
-        Index 0, 1 or 2 of the body-frame component.
+        Index 0, 1 or 2 of the body-frame component (an ``int`` or numpy
+        integer; not a bool or a float).
     refine : bool
         Polish with the exact solution.
 
     Returns
     -------
     ndarray, shape (F,)
+
+    Raises
+    ------
+    TypeError
+        ``traj`` not a :class:`~eulerpoisson.Trajectory`, ``component`` not an
+        integer, ``refine`` not a bool.
+    InvalidInputError
+        A batch trajectory, or ``component`` not 0, 1 or 2.
     """
+    from .trajectory import Trajectory
+
+    if not isinstance(traj, Trajectory):
+        raise TypeError(f"flip_times takes a Trajectory (the result of solve), got {type(traj).__name__} {traj!r}")
+    if isinstance(component, (bool, np.bool_)) or not isinstance(component, (int, np.integer)):
+        raise TypeError(f"component must be an integer 0, 1 or 2, got {type(component).__name__} {component!r}")
+    refine = _as_bool(refine, "refine")
     if traj.batch_shape:
-        raise InvalidInputError("flip_times takes a single-body trajectory")
+        raise InvalidInputError(f"flip_times takes a single-body trajectory, got batch shape {traj.batch_shape}")
     if component not in (0, 1, 2):
         raise InvalidInputError(f"component must be 0, 1 or 2, got {component!r}")
+    component = int(component)
     order = np.argsort(traj.t)
     t = traj.t[order]
     w = traj.omega[order, component]
-    idx = np.nonzero(np.sign(w[:-1]) * np.sign(w[1:]) < 0)[0]
-    t0, t1, w0, w1 = t[idx], t[idx + 1], w[idx], w[idx + 1]
-    roots = t0 - w0 * (t1 - t0) / (w1 - w0)
+    # consecutive nonzero samples of opposite sign (exact zeros in between are skipped)
+    nz = np.nonzero(w != 0)[0]
+    i, j = nz[:-1], nz[1:]
+    keep = np.sign(w[i]) != np.sign(w[j])
+    i, j = i[keep], j[keep]
+    t0, t1, w0, w1 = t[i], t[j], w[i], w[j]
+    adjacent = j == i + 1
+    roots = np.where(
+        adjacent,
+        t0 - w0 * (t1 - t0) / np.where(adjacent, w1 - w0, 1.0),
+        0.5 * (t[np.minimum(i + 1, t.size - 1)] + t[np.maximum(j - 1, 0)]),  # the zero sample(s)
+    )
     if not refine or roots.size == 0:
         return roots
     from .solvers import solve

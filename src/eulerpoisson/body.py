@@ -32,30 +32,99 @@ COLLINEAR_RTOL = 1e-12
 SYMMETRY_RTOL = 1e-12
 
 
+#: smallest principal moment accepted: the smallest normal float64 (a subnormal moment has no
+#: finite inverse, 1/5e-324 = inf)
+MIN_MOMENT = float(np.finfo(float).tiny)
+
+#: tensors whose largest entry lies outside [2**-EXP_SAFE, 2**EXP_SAFE] are scaled by a power of
+#: two before the eigen-decomposition (exact; inside the range nothing is scaled, bit for bit)
+EXP_SAFE = 500
+
+
+def _as_bool(value, name: str) -> bool:
+    """Return ``value`` as a Python bool; only ``bool`` and ``numpy.bool_`` are accepted.
+
+    Raises
+    ------
+    TypeError
+        For anything else (``"yes"``, ``1``, ``None``...): a truthy string is not a boolean option.
+    """
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise TypeError(f"{name} must be a bool (True or False), got {type(value).__name__} {value!r}")
+
+
+def _check_not_empty(a: np.ndarray, name: str, tail: int) -> None:
+    if a.size == 0:
+        raise InvalidInputError(
+            f"{name} is an empty batch of shape {a.shape} (batch shape {a.shape[:a.ndim - tail]}); "
+            "at least one body is needed"
+        )
+
+
+def _quarter_sum(x: np.ndarray) -> np.ndarray:
+    """``sum(x, -1) / 4`` without overflow (exact scaling by 1/4: ``(4 r) * _quarter_sum(x)`` has the
+    bits of ``r * sum(x)`` whenever the latter is finite and normal)."""
+    return np.sum(0.25 * x, -1)
+
+
+def _safe_exponent(a: np.ndarray) -> np.ndarray:
+    """Per-tensor power of two ``e`` (batch shape) that brings ``max|a|`` of a tensor (..., 3, 3) near 1
+    when it lies outside ``[2**-EXP_SAFE, 2**EXP_SAFE]``; 0 (no scaling) inside."""
+    e = np.frexp(np.max(np.abs(a), axis=(-1, -2)))[1]
+    return np.where(np.abs(e) > EXP_SAFE, e, 0)
+
+
 def _check_tensor(I: np.ndarray, name: str = "inertia") -> None:
     scale = np.max(np.abs(I), axis=(-1, -2), keepdims=True)
     if np.any(scale == 0):
         raise InvalidInertiaError(f"{name} is zero; a rigid body needs a positive-definite inertia tensor")
-    asym = np.max(np.abs(I - np.swapaxes(I, -1, -2)) / scale)
+    with np.errstate(over="ignore"):
+        asym = np.max(np.abs(I - np.swapaxes(I, -1, -2)) / scale)
     if asym > SYMMETRY_RTOL:
         raise InvalidInertiaError(
             f"{name} is not symmetric: max |I - I^T| / max |I| = {asym:.3g}; an inertia tensor must be symmetric"
         )
 
 
+def _raise_not_positive(ev: np.ndarray, bad_mask: np.ndarray, name: str):
+    bad = ev[np.any(bad_mask, axis=-1)][0]
+    # round-off noise such as -1e-17 prints as 0; huge values are printed as they are (np.round
+    # multiplies by 10**15 and would overflow)
+    shown = [float(np.round(x, 15)) if abs(x) < 1e200 else float(x) for x in bad]
+    raise InvalidInertiaError(
+        f"{name} is not positive definite: principal moments {shown}; "
+        "every principal moment must be > 0 (a body needs at least three non-collinear masses)"
+    )
+
+
+def _raise_tiny(ev: np.ndarray, bad_mask: np.ndarray, name: str):
+    bad = ev[np.any(bad_mask, axis=-1)][0]
+    raise InvalidInertiaError(
+        f"{name} has a principal moment below the smallest normal float64 {MIN_MOMENT:.6g}: principal "
+        f"moments {bad.tolist()}; the inverse inertia 1/I would not be finite (rescale the units)"
+    )
+
+
 def _check_moments(ev: np.ndarray, name: str = "inertia", triangle: bool = True) -> None:
-    """Positive and (unless ``triangle=False``) triangle inequalities on principal moments (..., 3)."""
-    if np.any(ev <= 0):
-        bad = ev[np.any(ev <= 0, axis=-1)][0]
+    """Positive, normal (not subnormal) and (unless ``triangle=False``) triangle inequalities on
+    principal moments (..., 3)."""
+    if not np.all(np.isfinite(ev)):
+        bad = ev[np.any(~np.isfinite(ev), axis=-1)][0]
         raise InvalidInertiaError(
-            f"{name} is not positive definite: principal moments {np.round(bad, 15).tolist()}; "
-            "every principal moment must be > 0 (a body needs at least three non-collinear masses)"
+            f"{name} has a principal moment that is not finite (it overflows float64): principal moments "
+            f"{bad.tolist()} (rescale the units)"
         )
+    if np.any(ev <= 0):
+        _raise_not_positive(ev, ev <= 0, name)
+    if np.any(ev < MIN_MOMENT):
+        _raise_tiny(ev, ev < MIN_MOMENT, name)
     if not triangle:
         return
     s = np.sort(ev, axis=-1)
-    slack = s[..., 0] + s[..., 1] - s[..., 2]
-    tol = DEGENERACY_RTOL * np.sum(s, -1)
+    with np.errstate(over="ignore"):  # s0 + s1 = inf only when it exceeds s2: satisfied
+        slack = s[..., 0] + s[..., 1] - s[..., 2]
+    tol = (4 * DEGENERACY_RTOL) * _quarter_sum(s)  # = DEGENERACY_RTOL * sum(s), without overflow
     if np.any(slack < -tol):
         bad = s[slack < -tol][0]
         raise InvalidInertiaError(
@@ -75,6 +144,12 @@ def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True):
 
 def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True):
     _check_tensor(a, name)
+    # very large or very small tensors are scaled by a power of two (exact) so that neither the
+    # symmetrization nor the eigen-decomposition overflows or underflows; ordinary ones are untouched
+    e = _safe_exponent(a)
+    scaled = bool(np.any(e != 0))
+    if scaled:
+        a = np.ldexp(a, -e[..., None, None])
     I = 0.5 * (a + np.swapaxes(a, -1, -2))
     ev, P = np.linalg.eigh(I)
     # right-handed principal frame
@@ -83,6 +158,15 @@ def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True):
     diag = np.all(I - I * np.eye(3) == 0, axis=(-1, -2))
     ev = np.where(diag[..., None], np.diagonal(I, axis1=-2, axis2=-1), ev)
     P = np.where(diag[..., None, None], np.eye(3), P)
+    if scaled:
+        if np.any(ev <= 0):
+            _raise_not_positive(np.ldexp(ev, e[..., None]), ev <= 0, name)
+        ev_s = ev
+        with np.errstate(under="ignore"):
+            ev = np.ldexp(ev_s, e[..., None])
+            I = np.ldexp(I, e[..., None, None])
+        if np.any(ev < MIN_MOMENT):
+            _raise_tiny(ev, ev < MIN_MOMENT, name)
     _check_moments(ev, name, triangle)
     return I, ev, P
 
@@ -123,10 +207,14 @@ class RigidBody:
     Raises
     ------
     InvalidInertiaError
-        Not symmetric, not positive definite, or violating the triangle
-        inequality (:math:`I_1 + I_2 < I_3` is not a physical body).
+        Not symmetric, not positive definite, a principal moment below
+        the smallest normal float64 (:data:`MIN_MOMENT`, whose inverse
+        would not be finite), or violating the triangle inequality
+        (:math:`I_1 + I_2 < I_3` is not a physical body).
     InvalidInputError
-        Wrong shape, NaN or infinite entries.
+        Wrong shape, an empty batch, NaN or infinite entries.
+    TypeError
+        ``allow_unphysical`` not a bool (``bool`` or ``numpy.bool_``).
 
     Notes
     -----
@@ -156,10 +244,12 @@ class RigidBody:
 
     def __init__(self, inertia, *, name: str | None = None, allow_unphysical: bool = False):
         a = as_float_array(inertia, "inertia")
-        triangle = not allow_unphysical
+        triangle = not _as_bool(allow_unphysical, "allow_unphysical")
         if a.ndim >= 2 and a.shape[-2:] == (3, 3):
+            _check_not_empty(a, "inertia", 2)
             I, ev, P = _principal_from_tensor(a, "inertia", triangle)
         elif a.ndim >= 1 and a.shape[-1] == 3:
+            _check_not_empty(a, "inertia", 1)
             I, ev, P = _principal_from_moments(a, "inertia", triangle)
         else:
             raise InvalidInputError(
@@ -198,13 +288,18 @@ class RigidBody:
         Raises
         ------
         InvalidInertiaError
-            A moment <= 0 or a violated triangle inequality.
+            A moment <= 0 or below :data:`MIN_MOMENT`, or a violated
+            triangle inequality.
         InvalidInputError
-            Wrong shape, NaN or infinite entries.
+            Wrong shape, an empty batch, NaN or infinite entries.
+        TypeError
+            ``allow_unphysical`` not a bool.
         """
         a = as_float_array(moments, "moments", (3,))
+        triangle = not _as_bool(allow_unphysical, "allow_unphysical")
+        _check_not_empty(a, "moments", 1)
         body = cls.__new__(cls)
-        body._set(*_principal_from_moments(a, "moments", not allow_unphysical), name)
+        body._set(*_principal_from_moments(a, "moments", triangle), name)
         return body
 
     # ------------------------------------------------------------------
@@ -235,9 +330,12 @@ class RigidBody:
         Raises
         ------
         InvalidInputError
-            Shapes that do not match, non-positive or non-finite masses, or
+            Shapes that do not match, non-positive or non-finite masses,
             fewer than three non-collinear masses (the inertia tensor would be
-            singular).
+            singular), or masses and positions whose inertia tensor overflows
+            or underflows float64 (masses and positions are scaled by powers of
+            two internally, so only an inertia that is itself out of range is
+            refused).
         """
         m = as_float_array(masses, "masses")
         x = as_float_array(positions, "positions", (3,))
@@ -251,17 +349,43 @@ class RigidBody:
             )
         if np.any(m <= 0):
             raise InvalidInputError(f"masses must all be > 0, got {_describe(m)}")
-        c = (m[:, None] * x).sum(0) / m.sum()
-        xr = x - c
-        scale = np.max(np.abs(xr))
-        sv = np.linalg.svd(xr / (scale if scale > 0 else 1.0), compute_uv=False)
+        # The inertia is homogeneous, I(s x, mu m) = mu s^2 I(x, m): masses and positions are scaled
+        # by powers of two (exact, so ordinary inputs give the same bits as without scaling) to keep
+        # sum(m x x) from overflowing or underflowing; only the final rescaling can leave the range.
+        em = int(np.frexp(np.max(m))[1])
+        ex = int(np.frexp(np.max(np.abs(x)))[1])
+        ms = np.ldexp(m, -em)
+        xs = np.ldexp(x, -ex)
+        cs = (ms[:, None] * xs).sum(0) / ms.sum()
+        xrs = xs - cs
+        scale = np.max(np.abs(xrs))
+        sv = np.linalg.svd(xrs / (scale if scale > 0 else 1.0), compute_uv=False)
         if scale == 0 or sv[1] <= COLLINEAR_RTOL * sv[0]:
             raise InvalidInputError(
                 f"the {m.shape[0]} masses are collinear (or coincide): a rigid body needs at least three "
                 "non-collinear masses (its inertia tensor would be singular)"
             )
-        g = np.einsum("n,ni,nj->ij", m, xr, xr)
-        I = np.trace(g) * np.eye(3) - g
+        gs = np.einsum("n,ni,nj->ij", ms, xrs, xrs)
+        Is = np.trace(gs) * np.eye(3) - gs
+        c = np.ldexp(cs, ex)
+        with np.errstate(over="ignore", under="ignore"):
+            xr = np.ldexp(xrs, ex)
+            I = np.ldexp(Is, em + 2 * ex)
+            ev_s = np.linalg.eigvalsh(Is)
+            ev = np.ldexp(ev_s, em + 2 * ex)
+        sizes = (f"masses up to {np.max(m):.6g} and positions relative to the centre of mass up to "
+                 f"{np.ldexp(scale, ex):.6g} in absolute value")
+        if not (np.all(np.isfinite(I)) and np.all(np.isfinite(ev)) and np.all(np.isfinite(xr))):
+            raise InvalidInputError(
+                f"the inertia tensor of these particles overflows float64 ({sizes}): "
+                "rescale the units of masses or positions"
+            )
+        if np.min(ev_s) > 0 and np.min(ev) < MIN_MOMENT:
+            raise InvalidInputError(
+                f"the inertia tensor of these particles underflows float64 (smallest principal moment "
+                f"about {np.min(ev_s):.6g} * 2**{em + 2 * ex}, below {MIN_MOMENT:.6g}; {sizes}): "
+                "rescale the units of masses or positions"
+            )
         body = cls(I, name=name)
         body.masses = m
         body.positions = xr
@@ -308,12 +432,20 @@ class RigidBody:
         :math:`g = \tfrac12\mathrm{tr}(I)\mathbf 1 - I` (eq. 1.3 uses :math:`g`). Positive
         semi-definite exactly when the triangle inequalities hold; singular for a planar body.
         """
-        tr = np.trace(self.inertia, axis1=-2, axis2=-1)
-        return 0.5 * tr[..., None, None] * np.eye(3) - self.inertia
+        I = self.inertia
+        # tensors near the float64 limits are scaled by a power of two (exact; g itself is in range)
+        e = _safe_exponent(I)
+        if np.any(e != 0):
+            I = np.ldexp(I, -e[..., None, None])
+        tr = np.trace(I, axis1=-2, axis2=-1)
+        g = 0.5 * tr[..., None, None] * np.eye(3) - I
+        return np.ldexp(g, e[..., None, None]) if np.any(e != 0) else g
 
     def _rel_close(self, a, b):
-        s = np.sum(np.abs(self.principal_moments), -1)
-        return np.abs(a - b) <= DEGENERACY_RTOL * s
+        # DEGENERACY_RTOL * sum|I_k|, without overflow for moments near the float64 maximum
+        s = _quarter_sum(np.abs(self.principal_moments))
+        with np.errstate(over="ignore", invalid="ignore"):
+            return np.abs(a - b) <= (4 * DEGENERACY_RTOL) * s
 
     @staticmethod
     def _flag(x):
@@ -345,7 +477,9 @@ class RigidBody:
         A bool for one body, a boolean array of the batch shape otherwise.
         """
         I = np.sort(self.principal_moments, -1)
-        return self._flag(self._rel_close(I[..., 0] + I[..., 1], I[..., 2]))
+        with np.errstate(over="ignore"):  # I1 + I2 = inf > I3: not planar
+            s = I[..., 0] + I[..., 1]
+        return self._flag(self._rel_close(s, I[..., 2]))
 
     @property
     def is_diagonal(self) -> bool:

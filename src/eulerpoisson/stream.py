@@ -327,11 +327,26 @@ def _done_chunks(work: Path) -> set[int]:
     return {int(p.name) for p in d.iterdir() if p.name.isdigit()}
 
 
+def _is_zarr_store(path: Path) -> bool:
+    """True for a folder holding a Zarr group or array (format 2 or 3 metadata at its top)."""
+    return any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zarray"))
+
+
+def _check_replaceable(dest: Path) -> None:
+    """FileExistsError when ``dest`` is a folder that is not a Zarr store (``overwrite`` must not delete it)."""
+    if dest.is_dir() and not dest.is_symlink() and not _is_zarr_store(dest):
+        raise FileExistsError(
+            f"refusing to replace {dest}: it is a folder but not a Zarr store (overwrite only replaces "
+            f"earlier results); remove it yourself or choose another path"
+        )
+
+
 def _replace_dir(src: Path, dest: Path, overwrite: bool) -> None:
     """Move folder ``src`` to ``dest``; an existing ``dest`` is replaced only with ``overwrite``."""
     if dest.exists() or dest.is_symlink():
         if not overwrite:
             raise FileExistsError(f"{dest} exists; pass overwrite=True to replace it")
+        _check_replaceable(dest)
         trash = dest.with_name(f".{dest.name}.old-{os.getpid()}")
         os.replace(dest, trash)
         os.replace(src, dest)
@@ -507,6 +522,8 @@ def solve_to_file(
         "variables": variables,
     }
 
+    if overwrite:
+        _check_replaceable(path)  # before any work, not after
     if path.exists() and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
     work = _work_dir(path)

@@ -120,7 +120,16 @@ from pathlib import Path
 import numpy as np
 
 from .errors import EulerPoissonError, InvalidInputError, require
-from .stream import _done_chunks, _mark_done, _Progress, _quiet_zarr, _replace_dir, _work_dir, _write_json_atomic
+from .stream import (
+    _check_replaceable,
+    _done_chunks,
+    _mark_done,
+    _Progress,
+    _quiet_zarr,
+    _replace_dir,
+    _work_dir,
+    _write_json_atomic,
+)
 
 __all__ = [
     "SweepConfig",
@@ -762,6 +771,8 @@ def run_sweep(
     fp = cfg.fingerprint()
     fp_text = json.dumps(fp, sort_keys=True)
 
+    if overwrite:
+        _check_replaceable(path)  # before any work, not after
     if path.exists():
         if not overwrite:
             try:

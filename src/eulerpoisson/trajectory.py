@@ -11,6 +11,7 @@ Trajectories are written to and read from NetCDF with CF-style attributes.
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from datetime import datetime, timezone
 
 import numpy as np
@@ -40,18 +41,30 @@ class Trajectory:
     Parameters
     ----------
     t : array_like, shape (T,)
-        Output times.
+        Output times, a 1-D array (``T = 0`` is allowed: an empty
+        trajectory, whose :meth:`drift` raises).
     quaternion : array_like, shape (*batch, T, 4)
         Attitudes (made unit and sign-continuous in time here).
     omega : array_like, shape (*batch, T, 3)
         Body angular velocities.
     body : RigidBody
+        One body, or a batch whose shape broadcasts to ``batch``.
     method : str
         Name of the method that produced it.
     options : dict, optional
         The method's options.
     stats : dict, optional
         Counters (wall time, steps, ...).
+
+    Raises
+    ------
+    InvalidInputError
+        ``t`` not 1-D, inconsistent shapes, NaN or infinite values, a zero
+        quaternion, or a body batch that does not broadcast to the batch of
+        the states.
+    TypeError
+        ``body`` not a :class:`RigidBody`, ``method`` not a string,
+        ``options``/``stats`` not mappings.
 
     Attributes
     ----------
@@ -66,6 +79,15 @@ class Trajectory:
 
     def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None):
         self.t = as_float_array(t, "t")
+        if self.t.ndim != 1:
+            raise InvalidInputError(f"t must be a 1-D array of output times, shape (T,); got shape {self.t.shape}")
+        if not isinstance(body, RigidBody):
+            raise TypeError(f"body must be a RigidBody, got {type(body).__name__} {body!r}")
+        if not isinstance(method, str):
+            raise TypeError(f"method must be a string, got {type(method).__name__} {method!r}")
+        for nm, val in (("options", options), ("stats", stats)):
+            if val is not None and not isinstance(val, Mapping):
+                raise TypeError(f"{nm} must be a dict (or None), got {type(val).__name__} {val!r}")
         q = as_float_array(quaternion, "quaternion", (4,))
         self.omega = as_float_array(omega, "omega", (3,))
         if q.shape[-2:-1] != self.t.shape or self.omega.shape[:-1] != q.shape[:-1]:
@@ -76,6 +98,16 @@ class Trajectory:
         # memory layout, and then two equal arrays could be normalized differently)
         w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
         nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
+        bshape = q.shape[:-2]
+        try:
+            ok = np.broadcast_shapes(body.batch_shape, bshape) == bshape
+        except ValueError:
+            ok = False
+        if not ok:
+            raise InvalidInputError(
+                f"the body's batch shape {body.batch_shape} does not broadcast to the trajectory's batch "
+                f"shape {bshape} (quaternion {q.shape}, omega {self.omega.shape})"
+            )
         if np.any(nrm == 0):
             raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
         # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
@@ -155,7 +187,19 @@ class Trajectory:
         dict
             Keys ``"energy"``, ``"m_norm"``, ``"m_x"``, ``"m_y"``, ``"m_z"``,
             each an array of the batch shape (a float for one body).
+
+        Raises
+        ------
+        InvalidInputError
+            For an empty trajectory (no output times, ``T = 0``): the drift is
+            measured from the values at ``t[0]``, which it does not have. (An
+            empty result would be read as "no drift"; the error is explicit.)
         """
+        if self.t.size == 0:
+            raise InvalidInputError(
+                "drift() is measured from the integrals at the first output time t[0], and this trajectory "
+                "has no output times (T = 0)"
+            )
         E = self.energy
         m = self.m
         mn = np.linalg.norm(m, axis=-1)
@@ -291,16 +335,42 @@ class Trajectory:
     def from_netcdf(cls, path) -> "Trajectory":
         """Read a trajectory written by :meth:`to_netcdf`.
 
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+
+        Returns
+        -------
+        Trajectory
+            Bit for bit the one written (times, attitudes, angular velocities).
+
         Raises
         ------
+        TypeError
+            ``path`` is not a file name (``str``, ``bytes`` or ``os.PathLike``).
         FileNotFoundError
             If the file does not exist.
         EulerPoissonError
-            If the file is not an eulerpoisson trajectory, or was written by
-            a newer, unknown format version.
+            If the file is not a readable NetCDF file or not an eulerpoisson
+            trajectory, or was written by a newer, unknown format version.
+        InvalidInputError
+            A malformed trajectory file; the message names the file and the
+            attribute or variable: a missing variable (``time``, ``inertia``,
+            particle data), a format version that is not a positive integer,
+            attributes (``batch_shape``, ``method_options``, ``stats``) that
+            are not the JSON written by :meth:`to_netcdf`, variables whose
+            shapes do not match ``batch_shape`` and the number of times, or
+            values the constructors reject (NaN, a non-physical inertia
+            tensor: :class:`InvalidInertiaError`), or a stored ``M`` that
+            disagrees with ``inertia @ omega`` (an edited file).
+        MissingDependencyError
+            If xarray or h5netcdf is missing (extra ``io``).
         """
         import os
 
+        if not isinstance(path, (str, bytes, os.PathLike)):
+            raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
         xr = require("xarray", "io")
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such file: {path}")
@@ -311,38 +381,110 @@ class Trajectory:
         ver = ds.attrs.get("eulerpoisson_format_version")
         if ver is None or "quaternion" not in ds or "omega" not in ds:
             raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory file")
-        if int(ver) > FORMAT_VERSION:
+        ver = _format_version(path, ver)
+        if ver > FORMAT_VERSION:
             raise EulerPoissonError(
-                f"{path} has format version {int(ver)}, newer than this eulerpoisson "
+                f"{path} has format version {ver}, newer than this eulerpoisson "
                 f"({FORMAT_VERSION}); upgrade the package"
             )
-        bshape = tuple(json.loads(ds.attrs.get("batch_shape", "[]")))
+        need = ["time", "inertia"]
+        if "particle_masses" in ds:
+            need += ["particle_positions", "center_of_mass"]
+        missing = [v for v in need if v not in ds]
+        if missing:
+            raise InvalidInputError(
+                f"{path}: malformed eulerpoisson trajectory file, variable(s) {missing} missing "
+                f"(expected {need} besides quaternion and omega)"
+            )
+        bshape = _json_attr(path, ds, "batch_shape", "[]", list)
+        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
+            raise InvalidInputError(
+                f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}"
+            )
+        bshape = tuple(bshape)
+        options = _json_attr(path, ds, "method_options", "{}", dict)
+        stats = _json_attr(path, ds, "stats", "{}", dict)
+        t = ds["time"].values
         q = ds["quaternion"].values
         w = ds["omega"].values
         inertia = ds["inertia"].values
+        if t.ndim != 1:
+            raise InvalidInputError(f"{path}: variable time must be 1-D, got shape {t.shape}")
+        lead = (int(np.prod(bshape)),) if bshape else ()
+        for nm, a, tail in (("quaternion", q, (t.shape[0], 4)), ("omega", w, (t.shape[0], 3)),
+                            ("inertia", inertia, (3, 3))):
+            if a.shape != lead + tail:
+                raise InvalidInputError(
+                    f"{path}: variable {nm} has shape {a.shape}, expected {lead + tail} "
+                    f"(batch_shape {list(bshape)}, {t.shape[0]} times)"
+                )
         if bshape:
             q = q.reshape(bshape + q.shape[1:])
             w = w.reshape(bshape + w.shape[1:])
             inertia = inertia.reshape(bshape + (3, 3))
         name = ds.attrs.get("body_name") or None
-        if "particle_masses" in ds:
-            body = RigidBody.from_particles(
-                ds["particle_masses"].values,
-                ds["particle_positions"].values + ds["center_of_mass"].values,
-                name=name,
+        try:
+            if "particle_masses" in ds:
+                body = RigidBody.from_particles(
+                    ds["particle_masses"].values,
+                    ds["particle_positions"].values + ds["center_of_mass"].values,
+                    name=name if name is None else str(name),
+                )
+            else:
+                body = RigidBody(inertia, name=name if name is None else str(name), allow_unphysical=True)
+            traj = cls(
+                t=t,
+                quaternion=q,
+                omega=w,
+                body=body,
+                method=str(ds.attrs.get("method", "")),
+                options=options,
+                stats=stats,
             )
-        else:
-            body = RigidBody(inertia, name=name, allow_unphysical=True)
-        return cls(
-            t=ds["time"].values,
-            quaternion=q,
-            omega=w,
-            body=body,
-            method=str(ds.attrs.get("method", "")),
-            options=json.loads(ds.attrs.get("method_options", "{}")),
-            stats=json.loads(ds.attrs.get("stats", "{}")),
-        )
+        except (InvalidInputError, TypeError) as exc:  # name the file (the type is kept)
+            raise type(exc)(f"{path}: {exc}") from exc
+        # the stored M = I Omega must agree with the inertia and omega read back (an edited inertia
+        # or omega would otherwise give a silently different motion)
+        Mf = ds["M"].values if "M" in ds else None
+        if (Mf is not None and t.size and np.issubdtype(Mf.dtype, np.floating)
+                and Mf.shape == lead + (t.shape[0], 3) and np.all(np.isfinite(Mf))):
+            Mf = Mf.reshape(traj.M.shape)
+            scale = np.max(np.abs(Mf), axis=(-1, -2), keepdims=True)
+            err = np.max(np.abs(traj.M - Mf) / np.where(scale > 0, scale, 1.0))
+            if not err <= 1e-9:
+                raise InvalidInputError(
+                    f"{path}: inconsistent file: the stored body angular momentum M differs from "
+                    f"inertia @ omega by {err:.3g} (relative); the inertia or omega variable was modified"
+                )
+        return traj
 
     def __repr__(self) -> str:
         b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
-        return f"Trajectory(method={self.method!r}, T={len(self.t)}, t=[{self.t.min():.6g}, {self.t.max():.6g}]{b})"
+        span = f"[{self.t.min():.6g}, {self.t.max():.6g}]" if self.t.size else "[]"
+        return f"Trajectory(method={self.method!r}, T={len(self.t)}, t={span}{b})"
+
+
+def _format_version(path, ver) -> int:
+    """The ``eulerpoisson_format_version`` attribute as a positive int, or InvalidInputError."""
+    v = ver.item() if isinstance(ver, np.ndarray) and ver.size == 1 else ver
+    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < 1:
+        raise InvalidInputError(
+            f"{path}: attribute eulerpoisson_format_version must be a positive integer, got {ver!r}"
+        )
+    return int(v)
+
+
+def _json_attr(path, ds, key: str, default: str, kind: type):
+    """Decode the JSON attribute ``key`` (a ``kind``: list or dict), or InvalidInputError naming the file."""
+    raw = ds.attrs.get(key, default)
+    try:
+        val = json.loads(raw)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(
+            f"{path}: attribute {key} is not valid JSON ({exc}): {str(raw)[:80]!r}"
+        ) from exc
+    if not isinstance(val, kind):
+        raise InvalidInputError(
+            f"{path}: attribute {key} must be a JSON {'list' if kind is list else 'object'}, got {raw!r}"
+        )
+    return val

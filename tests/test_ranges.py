@@ -194,3 +194,26 @@ def test_rk_relative_tolerances_scipy_would_change_are_refused(key, value):
     with pytest.raises(InvalidInputError, match=rf"rk: {key} must be in \[2.22e-14, 1\)"):
         solve(I123, [1.0], omega0=W0, method="rk", **{key: value})
     solve(I123, [1.0], omega0=W0, method="rk", tol=1e-13)  # the smallest tolerance of the benchmarks
+
+
+@pytest.mark.parametrize("eps_axis", [1e-60, 1e-81, 1e-90, 1e-99])
+def test_exact_near_the_separatrix_where_delta_underflows(eps_axis):
+    """Spin about the middle axis with a 1e-60..1e-99 perturbation (1 - k^2 down to 1e-198): R_J of
+    the regime-B integral once lost 10% to an underflow of (p-x)(p-y)(p-z) and d^2 (0.11 rad of
+    attitude error); the attitude is a plain rotation about axis 2 at rate 1 until the flip."""
+    t = np.array([-5.0, 1.0, 2.0, 5.0])
+    tr = solve(I123, t, omega0=[eps_axis, 1.0, eps_axis])
+    q = tr.quaternion
+    ref = np.stack([np.cos(t / 2), 0 * t, np.sin(t / 2), 0 * t], axis=-1)
+    dist = np.minimum(np.linalg.norm(q - ref, axis=-1), np.linalg.norm(q + ref, axis=-1))  # q and -q: one rotation
+    assert np.max(dist) < 1e-15
+
+
+def test_carlson_rj_with_underflowing_products():
+    mpmath = pytest.importorskip("mpmath")
+    from eulerpoisson._elliptic import _rj
+
+    for m1 in (1e-100, 1e-162, 1e-180, 1e-199, 1e-250, 1e-300):
+        v = _rj(np.array([0.0]), np.array([m1]), np.array([1.0]), np.array([0.25 * m1]))[0]
+        ref = float(mpmath.elliprj(0, m1, 1, 0.25 * m1))
+        assert abs(v / ref - 1) < 4 * np.finfo(float).eps, m1

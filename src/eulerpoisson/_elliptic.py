@@ -788,18 +788,45 @@ def _rc1(e, y):
     return np.where(pos, np.arctan(t) / ts, np.where(e < 0.0, neg, 1.0))
 
 
+def _rj_delta(x, y, z, p):
+    r"""``(delta, sc)``: :math:`\delta = (p-x)(p-y)(p-z)`, scaled against underflow.
+
+    :math:`|p-x|\le(\sqrt p+\sqrt x)^2`, so :math:`|\delta|\le d^2` in every
+    duplication step, and ``e = fac^3 delta / d^2`` is O(1) even when both
+    underflow (``p``, ``x``, ``y`` of order 1e-162 and below: the regime-B
+    integral ``R_J(0, m1, 1, m1 c)`` near the separatrix). Where
+    :math:`|\delta| < 2^{-960}` the two small factors are scaled by powers of
+    two into ``[1/2, 1)`` and ``sc`` is the square root of the total scale, so
+    that ``e = fac^3 delta / (d sc)^2`` exactly as before; elsewhere ``sc = 1``
+    and nothing changes (bit for bit).
+    """
+    f1, f2, f3 = p - x, p - y, p - z
+    delta = f1 * f2 * f3
+    sc = np.ones_like(delta)
+    tiny = (np.abs(delta) < 2.0**-960) & (f1 != 0) & (f2 != 0) & (f3 != 0)
+    if np.any(tiny):
+        e1 = np.where(tiny & (np.abs(f1) < 0.5), -np.frexp(f1)[1], 0)
+        e2 = np.where(tiny & (np.abs(f2) < 0.5), -np.frexp(f2)[1], 0)
+        e1 = e1 + (e1 + e2) % 2  # an even total: sc is an exact power of two
+        delta = np.where(tiny, np.ldexp(f1, e1) * np.ldexp(f2, e2) * f3, delta)
+        sc = np.where(tiny, np.ldexp(1.0, (e1 + e2) // 2), sc)
+    return delta, sc
+
+
 def _rj_step(st):
-    a, fac, x, y, z, p, acc, delta = st
+    a, fac, x, y, z, p, acc, delta, sc = st
     sx, sy, sz, sp = np.sqrt(x), np.sqrt(y), np.sqrt(z), np.sqrt(p)
     lam = sx * sy + sy * sz + sz * sx
     d = (sp + sx) * (sp + sy) * (sp + sz)
-    e = (fac * fac * fac) * delta / (d * d)
+    dd = d * sc
+    with np.errstate(over="ignore"):  # (d sc)^2 = inf only where e underflows to 0 anyway
+        e = (fac * fac * fac) * delta / (dd * dd)
     # 1 + e = 2 sqrt(p) (p + lambda) / d exactly (expand the products), which
     # avoids the cancellation in 1 + e for p << x, y, z
     y1 = 2.0 * sp * (p + lam) / d
     return [
         0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam),
-        0.25 * (z + lam), 0.25 * (p + lam), acc + fac * _rc1(e, y1) / d, delta,
+        0.25 * (z + lam), 0.25 * (p + lam), acc + fac * _rc1(e, y1) / d, delta, sc,
     ]
 
 
@@ -807,13 +834,13 @@ def _rj(x, y, z, p):
     """R_J for x, y, z >= 0 (at most one zero), p > 0 (no checks)."""
     shape, (x, y, z, p) = _flat(x, y, z, p)
     a0 = (x + y + z + 2.0 * p) / 5.0
-    delta = (p - x) * (p - y) * (p - z)
+    delta, sc = _rj_delta(x, y, z, p)
     q = _RDJ_QFAC * np.maximum(
         np.maximum(np.abs(a0 - x), np.abs(a0 - y)),
         np.maximum(np.abs(a0 - z), np.abs(a0 - p)),
     )
-    st = [a0, np.ones_like(a0), x, y, z, p, np.zeros_like(a0), delta]
-    a, fac, _, _, _, _, acc, _ = _duplicate(q, st, _rj_step)
+    st = [a0, np.ones_like(a0), x, y, z, p, np.zeros_like(a0), delta, sc]
+    a, fac, _, _, _, _, acc, _, _ = _duplicate(q, st, _rj_step)
     X = (a0 - x) * fac / a
     Y = (a0 - y) * fac / a
     Z = (a0 - z) * fac / a

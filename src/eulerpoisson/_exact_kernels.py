@@ -305,14 +305,24 @@ def _rc1(e, sp, p, lam, d):
 
 
 def _rj_init(x0, y0, z0, p0):
-    """``(A_0, delta, Q)`` of the ``R_J`` duplication."""
+    """``(A_0, delta, sc, Q)`` of the ``R_J`` duplication (``delta, sc`` as ``_elliptic._rj_delta``)."""
     a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0
-    delta = (p0 - x0) * (p0 - y0) * (p0 - z0)
+    f1 = p0 - x0
+    f2 = p0 - y0
+    f3 = p0 - z0
+    delta = f1 * f2 * f3
+    sc = 1.0
+    if abs(delta) < 2.0**-960 and f1 != 0.0 and f2 != 0.0 and f3 != 0.0:
+        e1 = -math.frexp(f1)[1] if abs(f1) < 0.5 else 0
+        e2 = -math.frexp(f2)[1] if abs(f2) < 0.5 else 0
+        e1 = e1 + (e1 + e2) % 2
+        delta = math.ldexp(f1, e1) * math.ldexp(f2, e2) * f3
+        sc = math.ldexp(1.0, (e1 + e2) // 2)
     q = _RDJ_QFAC * max(max(abs(a0 - x0), abs(a0 - y0)), max(abs(a0 - z0), abs(a0 - p0)))
-    return a0, delta, q
+    return a0, delta, sc, q
 
 
-def _rj_step(a, fac, x, y, z, p, acc, delta):
+def _rj_step(a, fac, x, y, z, p, acc, delta, sc):
     """One duplication step of ``R_J`` with its ``R_C`` term (``_elliptic._rj_step``)."""
     sx = math.sqrt(x)
     sy = math.sqrt(y)
@@ -320,7 +330,8 @@ def _rj_step(a, fac, x, y, z, p, acc, delta):
     sp = math.sqrt(p)
     lam = sx * sy + sy * sz + sz * sx
     d = (sp + sx) * (sp + sy) * (sp + sz)
-    e = (fac * fac * fac) * delta / (d * d)
+    dd = d * sc
+    e = (fac * fac * fac) * delta / (dd * dd)
     acc = acc + fac * _rc1(e, sp, p, lam, d) / d
     return (
         0.25 * (a + lam),
@@ -363,9 +374,9 @@ def _rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
     Every lane performs exactly the operations of ``_elliptic._rj`` and stops
     by its own criterion.  Lanes that are off return 0.
     """
-    a0a, dla, qa = _rj_init(xa, ya, za, pa)
-    a0b, dlb, qb = _rj_init(xb, yb, zb, pb)
-    a0c, dlc, qc = _rj_init(xc, yc, zc, pc)
+    a0a, dla, sca, qa = _rj_init(xa, ya, za, pa)
+    a0b, dlb, scb, qb = _rj_init(xb, yb, zb, pb)
+    a0c, dlc, scc, qc = _rj_init(xc, yc, zc, pc)
     A_a, fa, x_a, y_a, z_a, p_a, ca = a0a, 1.0, xa, ya, za, pa, 0.0
     A_b, fb, x_b, y_b, z_b, p_b, cb = a0b, 1.0, xb, yb, zb, pb, 0.0
     A_c, fc, x_c, y_c, z_c, p_c, cc = a0c, 1.0, xc, yc, zc, pc, 0.0
@@ -375,17 +386,17 @@ def _rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
     for _ in range(_MAX_DUPLICATION):
         if run_a:
             if fa * qa >= abs(A_a):
-                A_a, fa, x_a, y_a, z_a, p_a, ca = _rj_step(A_a, fa, x_a, y_a, z_a, p_a, ca, dla)
+                A_a, fa, x_a, y_a, z_a, p_a, ca = _rj_step(A_a, fa, x_a, y_a, z_a, p_a, ca, dla, sca)
             else:
                 run_a = False
         if run_b:
             if fb * qb >= abs(A_b):
-                A_b, fb, x_b, y_b, z_b, p_b, cb = _rj_step(A_b, fb, x_b, y_b, z_b, p_b, cb, dlb)
+                A_b, fb, x_b, y_b, z_b, p_b, cb = _rj_step(A_b, fb, x_b, y_b, z_b, p_b, cb, dlb, scb)
             else:
                 run_b = False
         if run_c:
             if fc * qc >= abs(A_c):
-                A_c, fc, x_c, y_c, z_c, p_c, cc = _rj_step(A_c, fc, x_c, y_c, z_c, p_c, cc, dlc)
+                A_c, fc, x_c, y_c, z_c, p_c, cc = _rj_step(A_c, fc, x_c, y_c, z_c, p_c, cc, dlc, scc)
             else:
                 run_c = False
         if not (run_a or run_b or run_c):

@@ -208,7 +208,7 @@ def test_flip_times_argument_checks():
         flip_times(tr, component=3)
     with pytest.raises(TypeError, match="flip_times takes a Trajectory.*got str 'x'"):
         flip_times("x")
-    with pytest.raises(TypeError, match="refine must be a bool"):
+    with pytest.raises(TypeError, match="refine must be True or False"):
         flip_times(tr, refine="no")
     # numpy integers are integers
     np.testing.assert_array_equal(flip_times(tr, np.int64(1), refine=False), flip_times(tr, 1, refine=False))
@@ -288,9 +288,9 @@ def test_smallest_normal_moment_has_finite_inverse():
 
 @pytest.mark.parametrize("value", ["yes", 1, 0, None, "False"])
 def test_allow_unphysical_must_be_bool(value):
-    with pytest.raises(TypeError, match="allow_unphysical must be a bool"):
+    with pytest.raises(TypeError, match="allow_unphysical must be True or False"):
         RigidBody(I123, allow_unphysical=value)
-    with pytest.raises(TypeError, match="allow_unphysical must be a bool"):
+    with pytest.raises(TypeError, match="allow_unphysical must be True or False"):
         RigidBody.from_moments(I123, allow_unphysical=value)
 
 

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_float_array
-from .body import _as_bool, _check_moments
+from ._validate import as_bool, as_float_array
+from .body import _check_moments
 from .errors import InvalidInputError
 
 __all__ = ["elliptic_parameters", "momentum_period", "tennis_racket_half_period", "flip_times"]
@@ -194,7 +194,7 @@ def flip_times(traj, component: int = 1, *, refine: bool = True) -> np.ndarray:
         raise TypeError(f"flip_times takes a Trajectory (the result of solve), got {type(traj).__name__} {traj!r}")
     if isinstance(component, (bool, np.bool_)) or not isinstance(component, (int, np.integer)):
         raise TypeError(f"component must be an integer 0, 1 or 2, got {type(component).__name__} {component!r}")
-    refine = _as_bool(refine, "refine")
+    refine = as_bool(refine, "refine")
     if traj.batch_shape:
         raise InvalidInputError(f"flip_times takes a single-body trajectory, got batch shape {traj.batch_shape}")
     if component not in (0, 1, 2):

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import _describe, as_float_array
+from ._validate import _describe, as_bool, as_float_array
 from .errors import InvalidInertiaError, InvalidInputError
 
 __all__ = ["RigidBody"]
@@ -39,19 +39,6 @@ MIN_MOMENT = float(np.finfo(float).tiny)
 #: tensors whose largest entry lies outside [2**-EXP_SAFE, 2**EXP_SAFE] are scaled by a power of
 #: two before the eigen-decomposition (exact; inside the range nothing is scaled, bit for bit)
 EXP_SAFE = 500
-
-
-def _as_bool(value, name: str) -> bool:
-    """Return ``value`` as a Python bool; only ``bool`` and ``numpy.bool_`` are accepted.
-
-    Raises
-    ------
-    TypeError
-        For anything else (``"yes"``, ``1``, ``None``...): a truthy string is not a boolean option.
-    """
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    raise TypeError(f"{name} must be a bool (True or False), got {type(value).__name__} {value!r}")
 
 
 def _check_not_empty(a: np.ndarray, name: str, tail: int) -> None:
@@ -244,7 +231,7 @@ class RigidBody:
 
     def __init__(self, inertia, *, name: str | None = None, allow_unphysical: bool = False):
         a = as_float_array(inertia, "inertia")
-        triangle = not _as_bool(allow_unphysical, "allow_unphysical")
+        triangle = not as_bool(allow_unphysical, "allow_unphysical")
         if a.ndim >= 2 and a.shape[-2:] == (3, 3):
             _check_not_empty(a, "inertia", 2)
             I, ev, P = _principal_from_tensor(a, "inertia", triangle)
@@ -296,7 +283,7 @@ class RigidBody:
             ``allow_unphysical`` not a bool.
         """
         a = as_float_array(moments, "moments", (3,))
-        triangle = not _as_bool(allow_unphysical, "allow_unphysical")
+        triangle = not as_bool(allow_unphysical, "allow_unphysical")
         _check_not_empty(a, "moments", 1)
         body = cls.__new__(cls)
         body._set(*_principal_from_moments(a, "moments", triangle), name)

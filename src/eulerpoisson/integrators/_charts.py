@@ -512,10 +512,10 @@ def check_step_budget(method: str, t, steps_per_unit_time: float, max_steps: int
         )
 
 
-def check_max_steps(method: str, value) -> int:
-    """``max_steps`` option: an integer >= 1 (not a bool)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InvalidInputError(f"{method}: max_steps must be an integer >= 1, got {value!r}")
+def check_count(method: str, key: str, value) -> int:
+    """A counting option (``max_steps``, ``max_iter``): an integer >= 1, not a bool."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidInputError(f"{method}: {key} must be an integer >= 1, got {value!r}")
     return int(value)
 
 

@@ -185,7 +185,7 @@ class RK(Method):
         if thr == 0:
             raise InvalidInputError("rk: chart_threshold must be > 0 (the chart event is |n| = chart_threshold)")
         cfg["chart_threshold"] = thr
-        cfg["max_steps"] = ch.check_max_steps("rk", cfg["max_steps"])
+        cfg["max_steps"] = ch.check_count("rk", "max_steps", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of the configured scipy integrator."""

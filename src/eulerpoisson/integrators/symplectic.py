@@ -526,11 +526,9 @@ class Symplectic(Method):
                 raise InvalidInputError(f"symplectic: dt must be a positive number or None, got {dt!r}")
             if not (math.isfinite(float(dt)) and float(dt) > 0):
                 raise InvalidInputError(f"symplectic: dt must be a finite number > 0, got {dt!r}")
-        mi = cfg["max_iter"]
-        if isinstance(mi, bool) or not isinstance(mi, (int, np.integer)) or mi < 1:
-            raise InvalidInputError(f"symplectic: max_iter must be an integer >= 1, got {mi!r}")
+        cfg["max_iter"] = ch.check_count("symplectic", "max_iter", cfg["max_iter"])
         cfg["chart_threshold"] = ch.check_threshold(cfg["chart_threshold"])
-        cfg["max_steps"] = ch.check_max_steps("symplectic", cfg["max_steps"])
+        cfg["max_steps"] = ch.check_count("symplectic", "max_steps", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of convergence of the configured scheme (2, 4 or 6)."""

@@ -345,7 +345,7 @@ def heyoka_reference(hy, t_end: float, *, kind: str = "real", prec: int = 113):
 
 def taylor_longdouble_reference(t_end: float):
     """Reference from eulerpoisson's Taylor integrator in numpy long double (tol 2e-19)."""
-    from eulerpoisson.integrators.taylor import integrate_principal
+    from eulerpoisson.solvers.taylor.method import integrate_principal
 
     ld = np.longdouble
     q, om, _ = integrate_principal(

@@ -29,7 +29,7 @@ def bodies(n: int, seed: int = 20240601) -> np.ndarray:
 
 
 def run(quick: bool = False, log=print) -> dict:
-    from eulerpoisson._exact import exact_motion
+    from eulerpoisson.solvers.exact.motion import exact_motion
     from eulerpoisson.solvers import solve
 
     cfg = {

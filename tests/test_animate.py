@@ -1,4 +1,4 @@
-"""Tests of eulerpoisson.animate: box geometry, slerp, occlusion, the HTML page (also in headless Chromium), GIF/MP4."""
+"""Tests of eulerpoisson.viz.animate: box geometry, slerp, occlusion, the HTML page (also in headless Chromium), GIF/MP4."""
 
 import json
 import os
@@ -13,8 +13,8 @@ matplotlib = pytest.importorskip("matplotlib")
 
 from _reference import reference_motion  # noqa: E402
 
-from eulerpoisson import animate as an  # noqa: E402
-from eulerpoisson.body import RigidBody  # noqa: E402
+from eulerpoisson.viz import animate as an  # noqa: E402
+from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.errors import InvalidInputError, MissingDependencyError  # noqa: E402
 from eulerpoisson.trajectory import Trajectory  # noqa: E402
 

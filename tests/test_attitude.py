@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from eulerpoisson import attitude as at
 from eulerpoisson.attitude import Attitude
-from eulerpoisson.body import RigidBody
+from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError, SingularChartError
 
 try:  # tests/ as a package or as a plain directory on sys.path

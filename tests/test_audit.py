@@ -1,4 +1,4 @@
-"""Tests of the paper audit (eulerpoisson.audit).
+"""Tests of the paper audit (eulerpoisson.paper.audit).
 
 The whole audit runs once (module fixture).  Verdicts are computed, so the
 tests check them against hand analysis of the paper, and check that they
@@ -19,7 +19,7 @@ import pytest
 
 pytest.importorskip("sympy")
 
-from eulerpoisson import audit as A  # noqa: E402
+from eulerpoisson.paper import audit as A  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
 
 #: every numbered equation of the paper (its \label{u...} values)

@@ -1,4 +1,4 @@
-"""Tests of eulerpoisson.body.RigidBody: validation, principal frame, point-mass bodies (paper eq. 1.1-1.3)."""
+"""Tests of eulerpoisson.model.body.RigidBody: validation, principal frame, point-mass bodies (paper eq. 1.1-1.3)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from eulerpoisson.body import RigidBody
+from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError
 
 try:  # tests/ as a package or as a plain directory on sys.path

@@ -168,7 +168,7 @@ def test_simulate_streams_to_zarr(capsys, tmp_path):
 
 
 def test_long_simulate_works_in_chunks(capsys, tmp_path):
-    from eulerpoisson.cli import CHUNKED_SAMPLES
+    from eulerpoisson.cli.commands import CHUNKED_SAMPLES
 
     n = CHUNKED_SAMPLES + 1
     path = tmp_path / "long.nc"

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
-from eulerpoisson import cli
-from eulerpoisson._io import atomic_path, atomic_write_text
+from eulerpoisson.cli import commands as cli
+from eulerpoisson.io.atomic import atomic_path, atomic_write_text
 from eulerpoisson.cli import main
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
 

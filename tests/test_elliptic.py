@@ -17,7 +17,7 @@ import pytest
 
 mp = pytest.importorskip("mpmath")
 
-from eulerpoisson import _elliptic as el  # noqa: E402
+from eulerpoisson.numerics import elliptic as el  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
 
 EPS = np.finfo(np.float64).eps

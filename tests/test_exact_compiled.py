@@ -1,7 +1,7 @@
 """The compiled (numba) path of the closed-form solution against the NumPy path.
 
-:mod:`eulerpoisson._exact_kernels` is a scalar transcription of the NumPy
-implementation in :mod:`eulerpoisson._exact` (same floating-point operations
+:mod:`eulerpoisson.solvers.exact.kernels` is a scalar transcription of the NumPy
+implementation in :mod:`eulerpoisson.solvers.exact.motion` (same floating-point operations
 in the same order).  Independent truths used here:
 
 * the NumPy path itself (the reference, validated against mpmath in
@@ -36,8 +36,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from eulerpoisson import _exact_kernels as K
-from eulerpoisson._exact import (
+from eulerpoisson.solvers.exact import kernels as K
+from eulerpoisson.solvers.exact.motion import (
     _exact_constants_compiled,
     _exact_constants_numpy,
     _exact_motion_compiled,
@@ -254,8 +254,8 @@ _SCRIPT = textwrap.dedent(
     import numpy as np
     sys.path.insert(0, sys.argv[3])
     from test_exact_compiled import _libm_numpy
-    from eulerpoisson import _exact_kernels as K
-    from eulerpoisson._exact import exact_motion, exact_constants
+    from eulerpoisson.solvers.exact import kernels as K
+    from eulerpoisson.solvers.exact.motion import exact_motion, exact_constants
     d = np.load(sys.argv[1])
     inertia, M0, t = d["inertia"], d["M0"], d["t"]
     res = exact_motion(inertia, M0, t)

@@ -1,4 +1,4 @@
-"""Tests of the closed-form free rigid-body kernel :mod:`eulerpoisson._exact`.
+"""Tests of the closed-form free rigid-body kernel :mod:`eulerpoisson.solvers.exact.motion`.
 
 Independent truths used here:
 
@@ -28,7 +28,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from eulerpoisson._exact import (
+from eulerpoisson.solvers.exact.motion import (
     EQUILIBRIUM,
     REGIME_A,
     REGIME_B,

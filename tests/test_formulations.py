@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from _reference import quaternion_distance, reference_motion
-from eulerpoisson import formulations as F
+from eulerpoisson.model import formulations as F
 from eulerpoisson.attitude import (
     inverse_conversion_matrix,
     matrix_from_gibbs,
@@ -24,7 +24,7 @@ from eulerpoisson.attitude import (
     omega_from_gibbs_rate,
     skew,
 )
-from eulerpoisson.body import RigidBody
+from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import (
     InvalidInertiaError,
     InvalidInputError,

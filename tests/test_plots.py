@@ -1,4 +1,4 @@
-"""Tests of eulerpoisson.plots: the data drawn is checked against closed forms and an independent scipy solution."""
+"""Tests of eulerpoisson.viz.plots: the data drawn is checked against closed forms and an independent scipy solution."""
 
 import os
 import sys
@@ -12,10 +12,10 @@ matplotlib = pytest.importorskip("matplotlib")
 from _reference import reference_motion  # noqa: E402
 
 from eulerpoisson.attitude import matrix_from_quaternion, quaternion_from_chart  # noqa: E402
-from eulerpoisson.body import RigidBody  # noqa: E402
+from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.errors import InvalidInputError, MissingDependencyError  # noqa: E402
 from eulerpoisson.trajectory import Trajectory  # noqa: E402
-from eulerpoisson import plots  # noqa: E402
+from eulerpoisson.viz import plots  # noqa: E402
 
 EPS = np.finfo(float).eps
 RACKET_I = np.array([3.0, 5.0, 7.0])
@@ -201,7 +201,7 @@ def test_invariants_closed_form_is_roundoff_and_matches_drift(racket):
         if ln.get_label() in ("E", "|m|", "m₁", "m₂", "m₃"):
             assert np.max(ln.get_ydata()) < 20 * EPS, ln.get_label()
     # the largest value of each curve is what Trajectory.drift reports
-    one = plots._select(racket)
+    one = plots.select_body(racket)
     curves = plots.invariant_drift(one)
     drift = racket.drift()
     for key, dkey in (("E", "energy"), ("|m|", "m_norm"), ("m₁", "m_x"), ("m₂", "m_y"), ("m₃", "m_z")):
@@ -213,7 +213,7 @@ def test_invariants_reference_is_first_given_time_for_unsorted_t(racket):
     perm = np.random.default_rng(1).permutation(len(racket.t))
     perm = np.concatenate([[100], perm[perm != 100]])  # t[0] is a mid-trajectory time
     tr = Trajectory(racket.t[perm], racket.quaternion[perm], racket.omega[perm], racket.body, method="m")
-    one = plots._select(tr)
+    one = plots.select_body(tr)
     assert np.all(np.diff(one.t) > 0)
     curves = plots.invariant_drift(one)
     assert curves["E"][100] == 0.0  # sorted position of the reference sample
@@ -387,10 +387,10 @@ def test_body_at_rest_and_time_unit():
 
 
 def test_exact_solver_pictures_if_available():
-    pytest.importorskip("eulerpoisson._exact", reason="the exact kernel is not written yet")
+    pytest.importorskip("eulerpoisson.solvers.exact.motion", reason="the exact kernel is not written yet")
     from eulerpoisson.solvers import solve
 
     tr = solve(RACKET_I, np.linspace(0, 150, 601), omega0=RACKET_OMEGA0, method="exact")
-    curves = plots.invariant_drift(plots._select(tr))
+    curves = plots.invariant_drift(plots.select_body(tr))
     for key, c in curves.items():
         assert np.max(c) < 1e-12, key  # exact solution: round-off-level drift

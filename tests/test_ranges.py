@@ -12,8 +12,8 @@ import pytest
 from eulerpoisson import RigidBody, solve
 from eulerpoisson.attitude import Attitude, euler_from_quaternion, quaternion_from_euler
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError, SingularChartError
-from eulerpoisson.exact import MAX_PHASE
-from eulerpoisson.formulations import MAX_GIBBS_NORM, formulation
+from eulerpoisson.solvers.exact.method import MAX_PHASE
+from eulerpoisson.model.formulations import MAX_GIBBS_NORM, formulation
 
 I123 = [1.0, 2.0, 3.0]
 W0 = np.array([1.0, 0.1, 0.5])
@@ -200,7 +200,7 @@ def test_exact_near_the_separatrix_where_delta_underflows(eps_axis):
 
 def test_carlson_rj_with_underflowing_products():
     mpmath = pytest.importorskip("mpmath")
-    from eulerpoisson._elliptic import _rj
+    from eulerpoisson.numerics.elliptic import _rj
 
     for m1 in (1e-100, 1e-162, 1e-180, 1e-199, 1e-250, 1e-300):
         v = _rj(np.array([0.0]), np.array([m1]), np.array([1.0]), np.array([0.25 * m1]))[0]

@@ -6,7 +6,7 @@ import pytest
 from _reference import quaternion_distance, reference_motion
 
 from eulerpoisson import InvalidInputError
-from eulerpoisson.integrators.rk import INTEGRATORS, RK
+from eulerpoisson.solvers.rk.method import INTEGRATORS, RK
 from eulerpoisson.solvers import solve
 
 BODY = [[2.0, 0.3, 0.0], [0.3, 1.5, 0.1], [0.0, 0.1, 2.5]]  # full tensor

@@ -203,7 +203,7 @@ def test_netcdf_batch_and_particles_round_trip(tmp_path, rng):
 
 
 def test_atomic_write_leaves_old_file_on_failure(tmp_path, monkeypatch):
-    from eulerpoisson._io import atomic_path
+    from eulerpoisson.io.atomic import atomic_path
 
     path = tmp_path / "keep.txt"
     path.write_text("old")

@@ -18,7 +18,7 @@ distributed = pytest.importorskip("distributed")
 
 from _reference import quaternion_distance, reference_motion  # noqa: E402
 
-from eulerpoisson import sweep  # noqa: E402
+from eulerpoisson.sweep import runner as sweep  # noqa: E402
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError  # noqa: E402
 from eulerpoisson.sweep import compute_points, load_config, load_sweep, plot_atlas, run_sweep  # noqa: E402
 
@@ -333,7 +333,7 @@ CHILD = textwrap.dedent(
     """
     import sys, time
     from pathlib import Path
-    from eulerpoisson import sweep
+    from eulerpoisson.sweep import runner as sweep
 
     flag = Path(sys.argv[2])
     real = sweep._compute_chunk

@@ -1,4 +1,4 @@
-"""Tests of eulerpoisson.symbolic against independent numeric truth.
+"""Tests of eulerpoisson.paper.symbolic against independent numeric truth.
 
 The derivation is compared with numbers computed without it: scipy's rotation
 of a quaternion, finite differences of R(n(t)), a kinetic energy built from
@@ -13,7 +13,7 @@ import pytest
 
 sp = pytest.importorskip("sympy")
 
-from eulerpoisson import symbolic as S  # noqa: E402
+from eulerpoisson.paper import symbolic as S  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
 
 RNG = np.random.default_rng(12345)

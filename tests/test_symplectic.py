@@ -18,8 +18,8 @@ from eulerpoisson.attitude import (
     matrix_from_gibbs,
     matrix_from_quaternion,
 )
-from eulerpoisson.integrators import _charts as ch
-from eulerpoisson.integrators.symplectic import (
+from eulerpoisson.solvers import charts as ch
+from eulerpoisson.solvers.symplectic.method import (
     Symplectic,
     gauss_step,
     gauss_tableau,

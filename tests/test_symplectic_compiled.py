@@ -17,8 +17,8 @@ import numpy as np
 import pytest
 
 from eulerpoisson import EulerPoissonError
-from eulerpoisson.integrators import _charts as ch
-from eulerpoisson.integrators import _symplectic_kernels as K
+from eulerpoisson.solvers import charts as ch
+from eulerpoisson.solvers.symplectic import kernels as K
 from eulerpoisson.solvers import solve
 
 numba_only = pytest.mark.skipif(not K.USE_NUMBA, reason="numba not installed or EULERPOISSON_NO_NUMBA=1")

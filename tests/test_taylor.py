@@ -21,8 +21,8 @@ from _reference import quaternion_distance, reference_motion
 
 from eulerpoisson import Attitude, RigidBody
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
-from eulerpoisson.integrators import _taylor_kernels as K
-from eulerpoisson.integrators.taylor import (
+from eulerpoisson.solvers.taylor import kernels as K
+from eulerpoisson.solvers.taylor.method import (
     DEFAULT_FIXED_ORDER,
     auto_order,
     integrate_principal,
@@ -194,9 +194,9 @@ def test_lie_series_terms_match_sympy_lie_derivatives():
 @pytest.mark.parametrize("case", ["diagonal_order8", "full_tensor_n0_order4"])
 def test_lie_series_terms_match_symbolic_audit(case):
     try:
-        from eulerpoisson.symbolic import lie_series
+        from eulerpoisson.paper.symbolic import lie_series
     except ImportError:
-        pytest.skip("eulerpoisson.symbolic (the audit's lie_series) is not available")
+        pytest.skip("eulerpoisson.paper.symbolic (the audit's lie_series) is not available")
     sp = pytest.importorskip("sympy")
     pi0 = [sp.Rational(3, 2), sp.Rational(-1, 2), sp.Rational(1)]
     if case == "diagonal_order8":
@@ -437,9 +437,9 @@ def test_agrees_with_independent_references(name, inertia, w0, rel):
 
 def test_agrees_with_exact_method_to_t100():
     try:
-        from eulerpoisson._exact import exact_motion  # noqa: F401
+        from eulerpoisson.solvers.exact.motion import exact_motion  # noqa: F401
     except ImportError:
-        pytest.skip("eulerpoisson._exact (the closed-form method) is not available yet")
+        pytest.skip("eulerpoisson.solvers.exact.motion (the closed-form method) is not available yet")
     R = random_rotation(2)
     cases = [
         ([1.0, 2.0, 3.0], [1.0, 0.1, 0.5]),
@@ -587,7 +587,7 @@ def test_lane_kernel_equals_scalar_kernel(dt, order):
 _LANES_PY_SCRIPT = r"""
 import json, sys
 import numpy as np
-from eulerpoisson.integrators import _taylor_kernels as K
+from eulerpoisson.solvers.taylor import kernels as K
 m, w0, q0, t = (np.array(json.loads(a)) for a in sys.argv[1:5])
 kw = dict(tol=1e-9, order=8, dt=None, max_steps=500, threshold=1.0)
 a = K.integrate_numba(m, w0, q0, t, lanes=False, **kw)
@@ -663,7 +663,7 @@ def test_body_at_rest_and_principal_axis_spin():
 _FALLBACK_SCRIPT = r"""
 import json, sys
 import numpy as np
-from eulerpoisson.integrators import _taylor_kernels as K
+from eulerpoisson.solvers.taylor import kernels as K
 from eulerpoisson.solvers import solve
 I = np.array(json.loads(sys.argv[1]))
 w0 = np.array(json.loads(sys.argv[2]))

@@ -12,11 +12,11 @@ try:
 except PackageNotFoundError:  # pragma: no cover - running from a source tree
     __version__ = "0+unknown"
 
-from .attitude import Attitude
-from .body import RigidBody
+from .attitude.core import Attitude
+from .model.body import RigidBody
 from .solvers import available_methods, solve
 from .trajectory import Trajectory
-from .formulations import FORMULATIONS, Formulation, formulation
+from .model.formulations import FORMULATIONS, Formulation, formulation
 from .errors import (
     EulerPoissonError,
     InvalidInertiaError,

@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validate import as_bool, as_float_array
-from .body import _check_moments
+from .util.validate import as_bool, as_float_array
+from .model.body import check_moments
 from .errors import InvalidInputError
 
 __all__ = ["elliptic_parameters", "momentum_period", "tennis_racket_half_period", "flip_times"]
@@ -74,7 +74,7 @@ def elliptic_parameters(inertia, M0) -> dict:
         raise InvalidInputError(
             f"elliptic_parameters takes one body: inertia and M0 of shape (3,), got shapes {I.shape} and {M.shape}"
         )
-    _check_moments(I, "inertia", triangle=False)
+    check_moments(I, "inertia", triangle=False)
     order = np.argsort(I)
     if not (I[order[0]] < I[order[1]] < I[order[2]]):
         raise InvalidInputError(f"elliptic_parameters needs three distinct principal moments, got {I.tolist()}")

@@ -16,10 +16,10 @@ from datetime import datetime, timezone
 
 import numpy as np
 
-from ._io import atomic_path
-from ._validate import as_float_array
-from .attitude import _matrix_from_unit_quaternion, quaternion_make_continuous
-from .body import RigidBody
+from .io.atomic import atomic_path
+from .util.validate import as_float_array
+from .attitude.core import matrix_from_unit_quaternion, quaternion_make_continuous
+from .model.body import RigidBody
 from .errors import EulerPoissonError, InvalidInputError, require
 
 __all__ = ["Trajectory", "FORMAT_VERSION"]
@@ -143,7 +143,7 @@ class Trajectory:
     @property
     def matrix(self) -> np.ndarray:
         """Rotation matrices R(t), (*batch, T, 3, 3)."""
-        return _matrix_from_unit_quaternion(self.quaternion)
+        return matrix_from_unit_quaternion(self.quaternion)
 
     @property
     def gibbs_singular(self) -> np.ndarray:

@@ -1,0 +1,11 @@
+r"""Attitude sets centred on the paper's rotation vector n = k tan(alpha/2).
+
+The functions ``<to>_from_<from>`` convert between the Gibbs vector, unit
+quaternions (scalar first), rotation matrices, axis-angle, the rotation vector
+alpha k (``rotvec``, scipy's), modified Rodrigues parameters and Euler angles;
+the paper's matrices A(n), Ã(n) and the metric G(n) = 4 A I Aᵀ are here too,
+and :class:`Attitude` is a thin class over them (see :mod:`.core`).
+"""
+
+from .core import *  # noqa: F401,F403
+from .core import __all__  # noqa: F401

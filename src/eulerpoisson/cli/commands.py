@@ -1,0 +1,884 @@
+"""The ``eulerpoisson`` command line.
+
+Commands: ``simulate``, ``audit``, ``plot``, ``animate``, ``info``, ``sweep``, ``demo``.
+Bad input prints one line that says what is wrong and exits with status 2
+(``--debug``, anywhere on the command line, shows the traceback instead).
+Python warnings (overflow, ill-conditioning, ...) are silenced unless
+``--debug`` is given, so that an error is a single line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import os
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import EulerPoissonError, MissingDependencyError
+
+__all__ = ["main"]
+
+EXIT_USAGE = 2
+
+#: frames per second accepted by ``animate --fps``
+FPS_RANGE = (1.0, 240.0)
+#: most frames of a GIF/MP4 written by ``animate`` (each frame is rendered by matplotlib)
+MAX_FRAMES = 1200
+
+
+class UsageError(EulerPoissonError, ValueError):
+    """Bad command-line input (exit status 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose errors are one line and exit status 2."""
+
+    def error(self, message):  # noqa: D401 - argparse API
+        raise UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
+
+
+# ---------------------------------------------------------------------------
+# parsing helpers
+# ---------------------------------------------------------------------------
+def _floats(text, name: str, sizes: tuple[int, ...]) -> list[float]:
+    if isinstance(text, (list, tuple)):
+        vals = text
+    else:
+        parts = [p for p in str(text).replace(";", ",").replace(" ", ",").split(",") if p != ""]
+        vals = []
+        for p in parts:
+            try:
+                vals.append(float(p))
+            except ValueError:
+                raise UsageError(f"{name}: {p!r} is not a number (expected {' or '.join(map(str, sizes))} comma-separated numbers)") from None
+    try:
+        arr = np.asarray(vals, dtype=float)
+    except (TypeError, ValueError):
+        raise UsageError(f"{name}: expected numbers, got {text!r}") from None
+    arr = arr.ravel()
+    if arr.size not in sizes:
+        raise UsageError(f"{name}: expected {' or '.join(map(str, sizes))} numbers, got {arr.size} ({text!r})")
+    if not np.all(np.isfinite(arr)):
+        raise UsageError(f"{name}: values must be finite, got {text!r}")
+    return arr.tolist()
+
+
+def _inertia_from(value, name="--inertia"):
+    v = _floats(value, name, (3, 9))
+    return np.array(v) if len(v) == 3 else np.array(v).reshape(3, 3)
+
+
+def _check_file_name(value, name: str) -> None:
+    """Reject an empty (or blank) file name given to option ``name``."""
+    if value is not None and not str(value).strip():
+        raise UsageError(f"{name}: empty file name")
+
+
+def _load_toml(path: str) -> dict:
+    import tomllib
+
+    _check_file_name(path, "configuration file")
+    p = Path(path)
+    if not p.exists():
+        raise UsageError(f"configuration file {path!r} does not exist")
+    if not p.is_file():
+        raise UsageError(f"configuration file {path!r} is not a file")
+    try:
+        with open(p, "rb") as fh:
+            return tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise UsageError(f"{path}: invalid TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise UsageError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
+                         "a TOML file must be UTF-8") from None
+
+
+#: what each TOML key of ``simulate`` holds (checked when the file is read; nothing is coerced)
+_TOML_KINDS = {
+    "body": {"inertia": "inertia", "masses": "numbers", "positions": "points", "name": "str"},
+    "initial": {"omega": "numbers", "m": "numbers", "quaternion": "numbers", "gibbs": "numbers"},
+    "time": {"t_end": "number", "samples": "int"},
+    "method": {"name": "str", "tol": "number", "dt": "number", "scheme": "str", "order": "int",
+               "integrator": "str", "rtol": "number", "atol": "number"},
+    "output": {"file": "str", "json": "bool"},
+}
+_TOML_KEYS = {sec: set(keys) for sec, keys in _TOML_KINDS.items()}
+
+
+def _show(v) -> str:
+    """A TOML value as the user wrote it (``true``, ``"abc"``, ``[[1, 2], [3]]``), shortened."""
+    try:
+        s = json.dumps(v)
+    except (TypeError, ValueError):
+        s = str(v)
+    return s if len(s) <= 80 else s[:77] + "..."
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _toml_value(kind: str, v, where: str):
+    """Check one TOML value against its ``kind``; return it (a 3x3 inertia flattened)."""
+    if kind == "str":
+        if not isinstance(v, str):
+            raise UsageError(f"{where} must be a string, got {_show(v)}")
+    elif kind == "bool":
+        if not isinstance(v, bool):
+            raise UsageError(f"{where} must be true or false, got {_show(v)}")
+    elif kind == "number":
+        if not _is_number(v):
+            raise UsageError(f"{where} must be a number, got {_show(v)}")
+    elif kind == "int":
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise UsageError(f"{where} must be an integer, got {_show(v)}")
+    elif kind == "numbers":
+        if not isinstance(v, list) or not all(_is_number(x) for x in v):
+            raise UsageError(f"{where} must be a list of numbers, got {_show(v)}")
+    elif kind == "points":
+        if not isinstance(v, list) or not all(
+            isinstance(row, list) and len(row) == 3 and all(_is_number(x) for x in row) for row in v
+        ):
+            raise UsageError(f"{where} must be a list of points [x, y, z] (three numbers each), got {_show(v)}")
+    elif kind == "inertia":
+        if isinstance(v, list) and v and all(isinstance(row, list) for row in v):
+            if len(v) != 3 or not all(len(row) == 3 and all(_is_number(x) for x in row) for row in v):
+                raise UsageError(f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of "
+                                 f"numbers, got {_show(v)}")
+            return [x for row in v for x in row]
+        if not isinstance(v, list) or not all(_is_number(x) for x in v):
+            raise UsageError(f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of "
+                             f"numbers, got {_show(v)}")
+    else:  # pragma: no cover - table above is closed
+        raise AssertionError(kind)
+    return v
+
+
+def _config_from_toml(cfg: dict, path: str, src: dict | None = None) -> dict:
+    """Flatten and check a ``simulate`` TOML file: ``{"section.key": value}``.
+
+    ``src`` (if given) receives, for each key, the name used in messages
+    (``"run.toml: [method] order"``).
+    """
+    out: dict = {}
+    for section, body in cfg.items():
+        if section not in _TOML_KEYS:
+            raise UsageError(f"{path}: unknown section [{section}]; known: {', '.join(sorted(_TOML_KEYS))}")
+        if not isinstance(body, dict):
+            raise UsageError(f"{path}: [{section}] must be a table")
+        unknown = set(body) - _TOML_KEYS[section]
+        if unknown:
+            raise UsageError(
+                f"{path}: unknown key(s) {', '.join(sorted(unknown))} in [{section}]; known: {', '.join(sorted(_TOML_KEYS[section]))}"
+            )
+        for k, v in body.items():
+            where = f"{path}: [{section}] {k}"
+            out[f"{section}.{k}"] = _toml_value(_TOML_KINDS[section][k], v, where)
+            if src is not None:
+                src[f"{section}.{k}"] = where
+    return out
+
+
+# ---------------------------------------------------------------------------
+# simulate
+# ---------------------------------------------------------------------------
+#: command-line flag of each configuration key (the name used in messages when the value came from a flag)
+_FLAGS = {
+    "body.inertia": "--inertia",
+    "initial.omega": "--omega",
+    "initial.m": "--m",
+    "initial.quaternion": "--quaternion",
+    "initial.gibbs": "--gibbs",
+    "time.t_end": "--t-end",
+    "time.samples": "--samples",
+    "method.name": "--method",
+    "method.tol": "--tol",
+    "method.dt": "--dt",
+    "method.scheme": "--scheme",
+    "output.file": "--out",
+}
+
+
+def _namer(src: dict):
+    """``name(key)``: the flag or ``file: [section] key`` a value came from."""
+
+    def name(key: str) -> str:
+        if key in src:
+            return src[key]
+        section, _, k = key.partition(".")
+        return _FLAGS.get(key, f"[{section}] {k}")
+
+    return name
+
+
+def _pair(name, k1: str, k2: str) -> tuple[str, str, str]:
+    """Names of two keys for one message: ``(prefix, a, b)``; the file is said once when both come from it."""
+    a, b = name(k1), name(k2)
+    fa, _, ra = a.rpartition(": ")
+    fb, _, rb = b.rpartition(": ")
+    if fa and fa == fb:
+        return f"{fa}: ", ra, rb
+    return "", a, b
+
+
+@contextlib.contextmanager
+def _naming_target(target):
+    """Re-word an OSError about a helper file next to ``target`` (``.NAME.partial``, ...) to name ``target``."""
+    try:
+        yield
+    except OSError as exc:
+        dest = Path(os.path.abspath(str(target)))
+
+        def helper(f) -> bool:  # dest's hidden sibling ``.NAME...`` or anything inside one
+            q = Path(os.path.abspath(os.fsdecode(f)))
+            return any(a.parent == dest.parent and a.name.startswith(f".{dest.name}") for a in (q, *q.parents))
+
+        for f in (exc.filename, exc.filename2):
+            if isinstance(f, (str, bytes)) and helper(f):
+                reason = exc.strerror or _message(exc)
+                raise (OSError(exc.errno, f"cannot write {target}: {reason}") if exc.errno is not None
+                       else OSError(f"cannot write {target}: {reason}")) from exc
+        raise
+
+
+def _build_body(cfg, name=None):
+    from ..model.body import RigidBody
+
+    name = name or _namer({})
+    label = cfg.get("body.name")
+    if "body.masses" in cfg or "body.positions" in cfg:
+        if "body.inertia" in cfg:
+            pre, a, b = _pair(name, "body.inertia", "body.masses" if "body.masses" in cfg else "body.positions")
+            raise UsageError(f"{pre}give either {a} or [body] masses and positions, not both")
+        if "body.masses" not in cfg or "body.positions" not in cfg:
+            raise UsageError("a point-mass body needs both [body] masses and [body] positions")
+        masses, positions = cfg["body.masses"], cfg["body.positions"]
+        if len(masses) != len(positions):
+            pre, a, b = _pair(name, "body.masses", "body.positions")
+            raise UsageError(f"{pre}{a} has {len(masses)} entries but {b} has {len(positions)} points; "
+                             "give one mass per point")
+        return RigidBody.from_particles(masses, positions, name=label)
+    if "body.inertia" not in cfg:
+        raise UsageError("no body given: use --inertia I1,I2,I3 (or nine numbers) or a TOML file with [body]")
+    return RigidBody(_inertia_from(cfg["body.inertia"], name("body.inertia")), name=label)
+
+
+def _method_options(cfg, name=None) -> dict:
+    name = name or _namer({})
+    opts = {}
+    for key in ("tol", "dt", "rtol", "atol"):
+        k = f"method.{key}"
+        if cfg.get(k) is not None:
+            try:
+                opts[key] = float(cfg[k])
+            except (TypeError, ValueError):
+                raise UsageError(f"{name(k)}: {cfg[k]!r} is not a number") from None
+            if not (math.isfinite(opts[key]) and opts[key] > 0):
+                raise UsageError(f"{name(k)} must be a positive number, got {cfg[k]!r}")
+    for key in ("scheme", "integrator"):
+        if cfg.get(f"method.{key}") is not None:
+            opts[key] = str(cfg[f"method.{key}"])
+    if cfg.get("method.order") is not None:
+        opts["order"] = cfg["method.order"]  # an int: checked when the file was read
+    return opts
+
+
+def _state_json(traj, drift) -> dict:
+    i = int(np.argmax(traj.t))
+    q = traj.quaternion[..., i, :]
+    sing = bool(q[0] == 0)
+    return {
+        "t": float(traj.t[i]),
+        "quaternion": q.tolist(),
+        "omega": traj.omega[..., i, :].tolist(),
+        "gibbs": None if sing else (q[1:] / q[0]).tolist(),
+        "m": traj.m[..., i, :].tolist(),
+        "energy": float(traj.energy[..., i]),
+        "method": traj.method,
+        "drift": {k: float(v) for k, v in drift.items()},
+    }
+
+
+#: output samples above which ``simulate`` works in chunks (and shows a progress bar on a terminal)
+CHUNKED_SAMPLES = 5000
+CHUNKS = 50
+
+
+def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
+    """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
+
+    The chunking depends only on the number of samples (never on whether a
+    terminal is attached), so a run gives the same numbers everywhere. The
+    closed form evaluates every chunk from the initial state (identical to one
+    call); stepping methods continue each chunk from the last state of the
+    previous one, as :func:`eulerpoisson.io.stream.solve_to_file` does.
+    """
+    from ..solvers import get_method, solve
+    from ..io.stream import ProgressDisplay
+    from ..trajectory import Trajectory
+
+    if t.size < CHUNKED_SAMPLES:
+        return solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    closed_form = get_method(method).order is None
+    pieces = np.array_split(np.arange(t.size), CHUNKS)
+    qs, ws, wall = [], [], 0.0
+    first = None
+    with ProgressDisplay(progress, t.size, f"{method}: solving") as bar:
+        done = 0
+        for idx in pieces:
+            if closed_form or first is None:
+                tr = solve(body, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+            else:
+                t0 = t[qs_end_index]
+                tr = solve(body, t[idx] - t0, omega0=ws[-1][-1], attitude0=qs[-1][-1], method=method, **opts)
+            first = tr if first is None else first
+            qs.append(tr.quaternion)
+            ws.append(tr.omega)
+            qs_end_index = idx[-1]
+            wall += tr.stats.get("wall_time", 0.0)
+            done += idx.size
+            bar.update(done)
+    stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
+    return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats)
+
+
+def cmd_simulate(args) -> int:
+    from ..attitude.core import quaternion_from_gibbs
+    from ..solvers import available_methods, solve
+
+    cfg: dict = {}
+    src: dict = {}
+    if args.config is not None:
+        cfg.update(_config_from_toml(_load_toml(args.config), args.config, src))
+        # a file that contradicts itself is an error even when a flag would replace both values
+        file_name = _namer(src)
+        for k1, k2, what in (("initial.omega", "initial.m", "exactly one of"),
+                             ("initial.quaternion", "initial.gibbs", "at most one of"),
+                             ("body.inertia", "body.masses", "either"), ("body.inertia", "body.positions", "either")):
+            if k1 in cfg and k2 in cfg:
+                pre, a, b = _pair(file_name, k1, k2)
+                raise UsageError(f"{pre}give {what} {a} {'or' if what == 'either' else 'and'} {b}, not both")
+    given = {key: getattr(args, attr) for attr, key in (
+        ("inertia", "body.inertia"), ("omega", "initial.omega"), ("m", "initial.m"),
+        ("quaternion", "initial.quaternion"), ("gibbs", "initial.gibbs"), ("t_end", "time.t_end"),
+        ("samples", "time.samples"), ("method", "method.name"), ("tol", "method.tol"), ("dt", "method.dt"),
+        ("scheme", "method.scheme"), ("out", "output.file"),
+    ) if getattr(args, attr, None) is not None}
+    # two flags that say the same thing differently are an error; a flag replaces what the file says
+    if "initial.omega" in given and "initial.m" in given:
+        raise UsageError("give exactly one of --omega and --m (the initial body angular velocity or the angular momentum), not both")
+    if "initial.quaternion" in given and "initial.gibbs" in given:
+        raise UsageError("give at most one of --quaternion and --gibbs (the initial attitude), not both")
+    replaces = {
+        "initial.omega": ("initial.m",),
+        "initial.m": ("initial.omega",),
+        "initial.quaternion": ("initial.gibbs",),
+        "initial.gibbs": ("initial.quaternion",),
+        "body.inertia": ("body.masses", "body.positions"),
+    }
+    for key, v in given.items():
+        for other in replaces.get(key, ()):
+            cfg.pop(other, None)
+            src.pop(other, None)
+        cfg[key] = v
+        src[key] = _FLAGS[key]
+    name = _namer(src)
+
+    body = _build_body(cfg, name)
+    if "initial.omega" in cfg and "initial.m" in cfg:
+        pre, a, b = _pair(name, "initial.omega", "initial.m")
+        raise UsageError(f"{pre}give exactly one of {a} and {b}, not both")
+    if "initial.omega" not in cfg and "initial.m" not in cfg:
+        raise UsageError("give exactly one initial condition: --omega W1,W2,W3 (body angular velocity) or --m (angular momentum)")
+    omega0 = m0 = None
+    if "initial.omega" in cfg:
+        omega0 = _floats(cfg["initial.omega"], name("initial.omega"), (3,))
+    else:
+        m0 = _floats(cfg["initial.m"], name("initial.m"), (3,))
+    if "initial.quaternion" in cfg and "initial.gibbs" in cfg:
+        pre, a, b = _pair(name, "initial.quaternion", "initial.gibbs")
+        raise UsageError(f"{pre}give at most one of {a} and {b}, not both")
+    q0 = None
+    if "initial.quaternion" in cfg:
+        q0 = np.array(_floats(cfg["initial.quaternion"], name("initial.quaternion"), (4,)))
+        nrm = float(np.linalg.norm(q0))
+        if abs(nrm - 1.0) > 1e-6:
+            raise UsageError(
+                f"{name('initial.quaternion')} must be a unit quaternion w,x,y,z (norm 1 within 1e-6); its norm is {nrm:.9g}"
+            )
+        q0 = q0 / nrm
+    elif "initial.gibbs" in cfg:
+        q0 = quaternion_from_gibbs(_floats(cfg["initial.gibbs"], name("initial.gibbs"), (3,)))
+    if "time.t_end" not in cfg:
+        raise UsageError("give the final time with --t-end T")
+    try:
+        t_end = float(cfg["time.t_end"])
+    except (TypeError, ValueError):
+        raise UsageError(f"{name('time.t_end')}: {cfg['time.t_end']!r} is not a number") from None
+    if not math.isfinite(t_end) or t_end < 0:
+        raise UsageError(f"{name('time.t_end')} must be a finite number >= 0, got {cfg['time.t_end']!r}")
+    samples = cfg.get("time.samples", 1001)
+    if isinstance(samples, str):
+        try:
+            samples = int(samples.strip())
+        except ValueError:
+            raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples!r}") from None
+    if samples < 2:
+        raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples}")
+    method = cfg.get("method.name", "exact")
+    if method not in available_methods():
+        raise UsageError(f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}")
+    opts = _method_options(cfg, name)
+    out = cfg.get("output.file")
+    _check_file_name(out, name("output.file"))
+    as_json = bool(args.json or cfg.get("output.json", False))
+    progress = False if (args.quiet or as_json) else None
+    if out is not None and not str(out).endswith((".nc", ".nc4", ".netcdf", ".zarr")):
+        raise UsageError(f"{name('output.file')} {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")
+    if out is not None and str(out).endswith(".zarr"):
+        # long runs stream to disk chunk by chunk (atomic, resumable); the final state is read back
+        from ..io.stream import solve_to_file
+
+        with _naming_target(out):
+            solve_to_file(body, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
+                          progress=progress, overwrite=True, **opts)
+        traj = solve(body, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    else:
+        t = np.linspace(0.0, t_end, samples)
+        traj = _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress)
+        if out is not None:
+            traj.to_netcdf(out)
+    drift = traj.drift()
+    if as_json:
+        print(json.dumps(_state_json(traj, drift)))
+    elif not args.quiet:
+        s = _state_json(traj, drift)
+        print(f"{traj.method}: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.3g} s")
+        print(f"  quaternion(T) = {np.round(s['quaternion'], 12).tolist()}")
+        print(f"  omega(T)      = {np.round(s['omega'], 12).tolist()}")
+        print(f"  energy        = {s['energy']:.15g}")
+        print("  relative drift: " + ", ".join(f"{k} {v:.2e}" for k, v in drift.items()))
+        if out is not None:
+            print(f"  wrote {out}")
+    return 0
+
+
+# ---------------------------------------------------------------------------
+# other commands
+# ---------------------------------------------------------------------------
+def cmd_audit(args) -> int:
+    from ..paper.audit import run_audit, write_report
+
+    _check_file_name(args.out, "--out")
+    report = run_audit()
+    if args.out is not None:
+        write_report(report, args.format, args.out)
+        if not args.quiet:
+            print(f"wrote {args.out}")
+    else:
+        text = {"md": report.to_markdown, "json": report.to_json, "tex": report.to_latex}[args.format]()
+        print(text)
+    return 0
+
+
+def _read_traj(path):
+    from ..trajectory import Trajectory
+
+    _check_file_name(path, "trajectory file")
+    if not os.path.exists(path):
+        raise UsageError(f"{path}: no such file (write one with 'eulerpoisson simulate ... --out {path}')")
+    if os.path.isdir(path):
+        raise UsageError(f"{path} is a directory, not a trajectory file (NetCDF, written by 'eulerpoisson simulate --out')")
+    try:
+        return Trajectory.from_netcdf(path)
+    except MissingDependencyError:
+        raise
+    except (EulerPoissonError, ValueError, TypeError, LookupError, AttributeError) as exc:
+        # a malformed file: make sure the message says which file
+        msg = _message(exc)
+        if str(path) in msg:
+            raise
+        raise EulerPoissonError(f"{path}: not a valid eulerpoisson trajectory file: {msg}") from exc
+
+
+def cmd_plot(args) -> int:
+    _check_file_name(args.out, "--out")
+    out = args.out if args.out is not None else f"{Path(args.file).stem}_{args.kind}.png"
+    if args.kind == "atlas":
+        from ..sweep.runner import load_sweep, plot_atlas
+
+        if not os.path.exists(args.file):
+            raise UsageError(f"{args.file}: no such sweep store (make one with 'eulerpoisson sweep sweep.toml')")
+        plot_atlas(load_sweep(args.file), out)
+    else:
+        from ..viz import plots
+
+        traj = _read_traj(args.file)
+        plots.plot(traj, args.kind, out=out)
+    if not args.quiet:
+        print(f"wrote {out}")
+    return 0
+
+
+def _fps(text) -> float:
+    lo, hi = FPS_RANGE
+    try:
+        fps = float(text)
+    except (TypeError, ValueError):
+        raise UsageError(f"--fps: {text!r} is not a number (frames per second, {lo:g} to {hi:g})") from None
+    if not (math.isfinite(fps) and lo <= fps <= hi):
+        raise UsageError(f"--fps must be between {lo:g} and {hi:g} frames per second, got {text!r}")
+    return int(fps) if fps.is_integer() else fps
+
+
+def cmd_animate(args) -> int:
+    from ..viz.animate import FORMATS, default_duration, animate
+
+    _check_file_name(args.out, "--out")
+    ext = Path(args.out).suffix.lower().lstrip(".")
+    if ext not in FORMATS and ext != "htm":
+        raise UsageError(f"--out {args.out!r}: unsupported file extension; use .html (self-contained page), .gif or .mp4")
+    video = ext in ("gif", "mp4")
+    if args.fps is not None and not video:
+        raise UsageError("--fps applies to .gif and .mp4 movies only (an HTML page animates at the browser's frame rate)")
+    fps = _fps(args.fps) if args.fps is not None else 30
+    traj = _read_traj(args.file)
+    if video:
+        span = float(np.max(traj.t) - np.min(traj.t))
+        nframes = int(round(fps * default_duration(span)))
+        if nframes > MAX_FRAMES:
+            dur = default_duration(span)
+            raise UsageError(
+                f"--fps {args.fps}: a {dur:g} s movie would have {nframes} frames, more than {MAX_FRAMES}; "
+                f"use --fps {int(MAX_FRAMES // dur)} or less"
+            )
+    animate(traj, args.out, fps=fps)
+    if not args.quiet:
+        print(f"wrote {args.out}")
+    return 0
+
+
+def cmd_info(args) -> int:
+    traj = _read_traj(args.file)
+    b = traj.body
+    lines = [
+        f"{args.file}: eulerpoisson trajectory",
+        f"  method      {traj.method} {json.dumps(traj.options) if traj.options else ''}".rstrip(),
+    ]
+    if len(traj.t) == 0:  # a valid file with no output times: nothing to measure
+        lines.append("  samples     0 (no output times)")
+        lines.append(f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}")
+        print("\n".join(lines))
+        return 0
+    lines.append(f"  samples     {len(traj.t)}, t from {traj.t.min():.6g} to {traj.t.max():.6g}")
+    if traj.batch_shape:
+        lines.append(f"  bodies      batch of shape {traj.batch_shape}")
+    else:
+        lines.append(f"  body        {b!r}")
+        lines.append(f"  energy      {float(traj.energy[0]):.15g}")
+        lines.append(f"  m           {np.round(traj.m[0], 12).tolist()}")
+    lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in traj.drift().items()))
+    print("\n".join(lines))
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from ..sweep.runner import load_config, run_sweep
+
+    _check_file_name(args.config, "sweep file")
+    _check_file_name(args.out, "--out")
+    if not os.path.exists(args.config):
+        raise UsageError(f"sweep file {args.config!r} does not exist (see examples/sweep.toml)")
+    if not os.path.isfile(args.config):
+        raise UsageError(f"sweep file {args.config!r} is not a file")
+    try:
+        cfg = load_config(args.config)
+    except UnicodeDecodeError as exc:
+        raise UsageError(f"{args.config}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
+                         "a TOML file must be UTF-8") from None
+    try:
+        with _naming_target(args.out if args.out is not None else cfg.path):
+            path = run_sweep(
+                cfg,
+                path=args.out,
+                scheduler=args.scheduler,
+                workers=args.workers,
+                progress=False if args.quiet else None,
+                overwrite=args.overwrite,
+            )
+    except (EulerPoissonError, OSError) as exc:
+        # the library speaks of its keyword argument; on the command line it is a flag
+        msg = str(exc)
+        if "overwrite=True" in msg:
+            raise EulerPoissonError(msg.replace("pass overwrite=True", "run again with --overwrite")
+                                    .replace("overwrite=True", "--overwrite")) from exc
+        raise
+    if not args.quiet:
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_demo(args) -> int:
+    from .demo import run_demo
+
+    _check_file_name(args.out, "--out")
+    return run_demo(args.out, quiet=args.quiet)
+
+
+# ---------------------------------------------------------------------------
+def build_parser() -> argparse.ArgumentParser:
+    from .. import __version__
+
+    p = _Parser(
+        prog="eulerpoisson",
+        description="The free rigid body in the Gibbs rotation vector n = k tan(alpha/2): "
+        "exact motion, integrators, the paper's audit, files and pictures.",
+        epilog="Run 'eulerpoisson COMMAND --help' for a command's options and examples.",
+    )
+    p.add_argument("--version", action="version", version=f"eulerpoisson {__version__}")
+    p.add_argument("--debug", action="store_true",
+                   help="show tracebacks and warnings instead of one-line errors (accepted anywhere on the line)")
+    sub = p.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
+
+    ex = argparse.RawDescriptionHelpFormatter
+    s = sub.add_parser(
+        "simulate",
+        help="solve the motion of a body and print or save it",
+        formatter_class=ex,
+        description="Solve the free rigid body from an initial state.",
+        epilog=(
+            "examples:\n"
+            "  eulerpoisson simulate --inertia 3,5,9 --omega 0,0.4,0.001 --t-end 50 --json\n"
+            "  eulerpoisson simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 100 --method taylor --tol 1e-15 --out run.nc\n"
+            "  eulerpoisson simulate run.toml --t-end 20     # flags override the file\n\n"
+            "TOML file sections: [body] inertia=[...] | masses=[...], positions=[[...]...]; name\n"
+            "  [initial] omega=[...] | m=[...]; quaternion=[w,x,y,z] | gibbs=[...]\n"
+            "  [time] t_end, samples   [method] name, tol, dt, scheme, order, integrator, rtol, atol\n"
+            "  [output] file, json"
+        ),
+    )
+    s.add_argument("config", nargs="?", help="optional TOML file describing the run")
+    s.add_argument("--inertia", help="principal moments I1,I2,I3 or nine numbers of a full tensor (row-major)")
+    s.add_argument("--omega", help="initial body angular velocity W1,W2,W3")
+    s.add_argument("--m", help="initial spatial angular momentum m1,m2,m3 (instead of --omega)")
+    s.add_argument("--quaternion", help="initial attitude w,x,y,z (unit, scalar first); default identity")
+    s.add_argument("--gibbs", help="initial attitude as the Gibbs vector n1,n2,n3")
+    s.add_argument("--t-end", dest="t_end", help="final time T >= 0")
+    s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
+    s.add_argument("--method", help="solution method (default exact)")
+    s.add_argument("--tol", help="tolerance for adaptive methods")
+    s.add_argument("--dt", help="step size for fixed-step methods")
+    s.add_argument("--scheme", help="scheme of the symplectic method (gauss2, gauss4, gauss6, ...)")
+    s.add_argument("--out", help="write the trajectory to this NetCDF file")
+    s.add_argument("--json", action="store_true", help="print the state at T as one JSON object")
+    s.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    s.set_defaults(func=cmd_simulate)
+
+    a = sub.add_parser(
+        "audit",
+        help="derive the paper's equations with SymPy and report which are confirmed",
+        formatter_class=ex,
+        epilog="examples:\n  eulerpoisson audit\n  eulerpoisson audit --format json --out audit.json\n  eulerpoisson audit --format tex --out audit.tex",
+    )
+    a.add_argument("--format", choices=["md", "json", "tex"], default="md", help="report format (default md)")
+    a.add_argument("--out", help="write the report to this file instead of printing it")
+    a.add_argument("--quiet", action="store_true")
+    a.set_defaults(func=cmd_audit)
+
+    pl = sub.add_parser(
+        "plot",
+        help="draw a figure from a trajectory file",
+        formatter_class=ex,
+        epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf",
+    )
+    pl.add_argument("file", help="trajectory NetCDF file written by 'simulate --out' (or a sweep store for --kind atlas)")
+    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "atlas"])
+    pl.add_argument("--out", help="figure file (.png, .svg or .pdf)")
+    pl.add_argument("--quiet", action="store_true")
+    pl.set_defaults(func=cmd_plot)
+
+    an = sub.add_parser(
+        "animate",
+        help="animate the tumbling body (self-contained HTML, GIF or MP4)",
+        formatter_class=ex,
+        epilog="examples:\n  eulerpoisson animate run.nc --out movie.html\n  eulerpoisson animate run.nc --out movie.gif",
+    )
+    an.add_argument("file", help="trajectory NetCDF file")
+    an.add_argument("--out", required=True, help="movie.html, movie.gif or movie.mp4")
+    an.add_argument("--fps", help=f"frames per second of a .gif/.mp4 ({FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}, default 30)")
+    an.add_argument("--quiet", action="store_true")
+    an.set_defaults(func=cmd_animate)
+
+    sw = sub.add_parser(
+        "sweep",
+        help="a grid or random sweep over inertia ratios and initial states, on Dask, into Zarr",
+        formatter_class=ex,
+        epilog=(
+            "examples:\n  eulerpoisson sweep examples/sweep.toml\n"
+            "  eulerpoisson sweep atlas.toml --scheduler tcp://10.0.0.5:8786 --out atlas.zarr\n"
+            "  eulerpoisson plot atlas.zarr --kind atlas --out atlas.png\n\n"
+            "An interrupted sweep resumes where it stopped when run again."
+        ),
+    )
+    sw.add_argument("config", help="TOML file describing the sweep (see examples/sweep.toml)")
+    sw.add_argument("--out", help="Zarr store (default: [output] path of the file)")
+    sw.add_argument("--scheduler", help="'local' (default, an embedded cluster), 'serial', or tcp://HOST:PORT")
+    sw.add_argument("--workers", type=int, help="workers of the local cluster")
+    sw.add_argument("--overwrite", action="store_true", help="replace a store made with another configuration")
+    sw.add_argument("--quiet", action="store_true")
+    sw.set_defaults(func=cmd_sweep)
+
+    i = sub.add_parser("info", help="describe a trajectory file", epilog="example:\n  eulerpoisson info run.nc", formatter_class=ex)
+    i.add_argument("file")
+    i.set_defaults(func=cmd_info)
+
+    d = sub.add_parser(
+        "demo",
+        help="the showcase: the tennis-racket effect, figures, animation and audit",
+        epilog="example:\n  eulerpoisson demo --out out",
+        formatter_class=ex,
+    )
+    d.add_argument("--out", default="out", help="output folder (default out/)")
+    d.add_argument("--quiet", action="store_true")
+    d.set_defaults(func=cmd_demo)
+    return p
+
+
+
+
+# ---------------------------------------------------------------------------
+# argv pre-processing
+# ---------------------------------------------------------------------------
+def _value_options(parser: argparse.ArgumentParser) -> tuple[set[str], set[str]]:
+    """Long options that take a value, and all option strings, of ``parser`` and its subcommands."""
+    takes, every = set(), set()
+    stack = [parser]
+    while stack:
+        p = stack.pop()
+        for action in p._actions:
+            every.update(action.option_strings)
+            if action.option_strings and action.nargs != 0:
+                takes.update(o for o in action.option_strings if o.startswith("--"))
+            if isinstance(action, argparse._SubParsersAction):
+                stack.extend(action.choices.values())
+    return takes, every
+
+
+def _prepare_argv(argv: list[str], parser: argparse.ArgumentParser) -> list[str]:
+    """Drop ``--debug`` (accepted anywhere) and glue values that begin with '-' to their option.
+
+    argparse reads ``--omega -1,0.1,0.5`` as two options; ``--omega=-1,0.1,0.5``
+    is what the user meant. A value is glued to a value-taking long option (or
+    an abbreviation of one) when it begins with a single '-' and is not itself
+    a known option.
+    """
+    takes, every = _value_options(parser)
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        tok = argv[i]
+        if tok == "--":
+            out.extend(argv[i:])
+            break
+        if tok == "--debug":
+            i += 1
+            continue
+        if (
+            tok.startswith("--") and "=" not in tok and len(tok) > 2 and i + 1 < len(argv)
+            and any(o.startswith(tok) for o in takes)
+        ):
+            nxt = argv[i + 1]
+            if nxt.startswith("-") and not nxt.startswith("--") and nxt not in every and len(nxt) > 1:
+                out.append(f"{tok}={nxt}")
+                i += 2
+                continue
+        out.append(tok)
+        i += 1
+    return out
+
+
+def _message(exc: BaseException) -> str:
+    """The first non-empty line of an exception's message (the type name if it has none)."""
+    if isinstance(exc, KeyError) and len(exc.args) == 1 and isinstance(exc.args[0], str):
+        text = exc.args[0]  # str(KeyError) is the repr of its argument
+    elif isinstance(exc, OSError) and exc.strerror and exc.filename is None:
+        text = exc.strerror  # without the "[Errno N]" prefix
+    else:
+        text = str(exc)
+    for line in text.splitlines():
+        if line.strip():
+            return line.strip()
+    return type(exc).__name__
+
+
+def _error_line(exc: BaseException) -> str:
+    msg = _message(exc)
+    if isinstance(exc, UsageError):
+        return msg
+    if isinstance(exc, MemoryError):
+        msg = f"out of memory: {msg}" if msg != type(exc).__name__ else "out of memory"
+    elif isinstance(exc, OverflowError) and "overflow" not in msg.lower():
+        msg = f"numerical overflow: {msg}"
+    elif not isinstance(exc, (EulerPoissonError, ValueError, TypeError, OSError, ArithmeticError, LookupError,
+                              ImportError)):
+        msg = f"{type(exc).__name__}: {msg}"  # unexpected: say what kind of failure it was
+    return f"eulerpoisson: error: {msg}"
+
+
+@contextlib.contextmanager
+def _quiet_warnings(enabled: bool):
+    """Silence Python warnings here and in worker processes started meanwhile (when ``enabled``)."""
+    if not enabled:
+        yield
+        return
+    old = os.environ.get("PYTHONWARNINGS")
+    os.environ["PYTHONWARNINGS"] = "ignore"
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        if old is None:
+            os.environ.pop("PYTHONWARNINGS", None)
+        else:
+            os.environ["PYTHONWARNINGS"] = old
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``eulerpoisson`` command; returns the exit status.
+
+    Bad input, and any failure of a command, prints one line
+    ``eulerpoisson: error: ...`` (or the usage message) to stderr and returns
+    2; ``--debug`` anywhere on the command line shows the traceback (and
+    Python warnings) instead.
+    """
+    argv = [str(a) for a in (sys.argv[1:] if argv is None else argv)]
+    debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv
+    try:
+        with _quiet_warnings(not debug):
+            parser = build_parser()
+            args = parser.parse_args(_prepare_argv(argv, parser))
+            if not getattr(args, "command", None):
+                parser.print_help()
+                return EXIT_USAGE
+            return int(args.func(args) or 0)
+    except SystemExit as exc:  # --help / --version
+        return int(exc.code or 0) if isinstance(exc.code, int) else 0
+    except KeyboardInterrupt:
+        print("eulerpoisson: interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # noqa: BLE001 - the command line never shows a traceback without --debug
+        if debug:
+            raise
+        print(_error_line(exc), file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

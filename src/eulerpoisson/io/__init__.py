@@ -1,0 +1,1 @@
+"""Files: atomic writes (:mod:`.atomic`) and streaming of long runs to Zarr (:mod:`.stream`)."""

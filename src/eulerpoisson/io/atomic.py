@@ -1,0 +1,107 @@
+"""Atomic file writes (private).
+
+Results are written to a temporary file in the destination folder and moved
+into place with :func:`os.replace`, so an interrupted run (Ctrl-C, a crash, a
+full disk) never leaves a half-written file under the final name.
+
+Errors name the file the caller asked for, never the temporary file: a
+failure to write raises :class:`OSError` (the subclass and ``errno`` of the
+original error, e.g. :class:`FileNotFoundError`) with the message
+``cannot write PATH: REASON``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno as _errno
+import os
+import tempfile
+from pathlib import Path
+
+from ..errors import InvalidInputError
+
+
+def _target(path) -> Path:
+    """Check a destination file name: not empty, not an existing directory."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
+    text = os.fspath(path)
+    if not str(text).strip():
+        raise InvalidInputError("cannot write a file with an empty name; give a file name")
+    dest = Path(text)
+    if dest.is_dir():
+        raise IsADirectoryError(_errno.EISDIR, f"cannot write {text}: it is an existing directory; give a file name")
+    return dest
+
+
+def _write_error(dest, exc: OSError) -> OSError:
+    """``exc`` re-worded to name ``dest`` (the caller's file), keeping its errno and class."""
+    reason = exc.strerror or str(exc) or type(exc).__name__
+    if exc.errno is None:
+        return OSError(f"cannot write {dest}: {reason}")
+    return OSError(exc.errno, f"cannot write {dest}: {reason}")  # OSError(errno, ...) picks the subclass
+
+
+def _names_tmp(exc: OSError, tmp: str) -> bool:
+    return tmp in (exc.filename, exc.filename2) or os.path.basename(tmp) in str(exc)
+
+
+@contextlib.contextmanager
+def atomic_path(path, suffix: str | None = None):
+    """Yield a temporary path next to ``path``; on success rename it to ``path``.
+
+    On any exception (including ``KeyboardInterrupt``) the temporary file is
+    removed and the previous content of ``path``, if any, is untouched.
+
+    Raises
+    ------
+    InvalidInputError
+        ``path`` is empty.
+    IsADirectoryError
+        ``path`` is an existing directory.
+    OSError
+        The file cannot be written (missing or read-only folder, full disk,
+        ...): the message is ``cannot write PATH: REASON``, naming ``path``
+        (not the temporary file); ``errno`` and the subclass are those of the
+        original error.
+    """
+    dest = _target(path)
+    parent = dest.parent if str(dest.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix or ".tmp", dir=parent)
+    except OSError as exc:
+        raise _write_error(dest, exc) from exc
+    os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; give the file the usual permissions
+    try:
+        try:
+            yield tmp
+        except OSError as exc:
+            if _names_tmp(exc, tmp):
+                raise _write_error(dest, exc) from exc
+            raise
+        try:
+            os.replace(tmp, dest)
+        except OSError as exc:
+            raise _write_error(dest, exc) from exc
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def atomic_write_text(path, text: str, encoding: str = "utf-8") -> None:
+    """Write ``text`` to ``path`` atomically.
+
+    Raises
+    ------
+    InvalidInputError, IsADirectoryError, OSError
+        As :func:`atomic_path`: an empty name, an existing directory, or a
+        failure to write (the message names ``path``).
+    """
+    with atomic_path(path) as tmp:
+        with open(tmp, "w", encoding=encoding) as fh:
+            fh.write(text)

@@ -1,0 +1,1 @@
+"""Numerical building blocks: elliptic functions and integrals, the quaternion product."""

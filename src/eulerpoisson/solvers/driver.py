@@ -1,0 +1,93 @@
+r"""The ``solve`` driver: one call for every registered method.
+
+A method receives a :class:`~eulerpoisson.solvers.problem.Problem` (bodies,
+initial attitudes and body angular velocities, output times, all batched) and
+returns the attitude quaternions and body angular velocities at the output
+times; :func:`solve` wraps them in a :class:`~eulerpoisson.trajectory.Trajectory`.
+
+References
+----------
+Paper eq. 1.4-1.5 (the equations solved) and 1.23.1 (the general solution as
+the exponential of the Hamiltonian vector field).
+"""
+
+from __future__ import annotations
+
+import time as _time
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from ..trajectory import Trajectory
+from .problem import make_problem
+from .registry import get_method
+
+__all__ = ["solve"]
+
+
+def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact", **options):
+    r"""Motion of free rigid bodies at the output times ``t``.
+
+    Parameters
+    ----------
+    body : RigidBody or array_like
+        The body (or a batch of bodies); an array is passed to :class:`RigidBody`.
+    t : float or array_like, shape (T,)
+        Output times, any order; negative times run the motion backwards
+        from the initial state at ``t = 0``.
+    omega0 : array_like, shape (..., 3), optional
+        Initial body angular velocity :math:`\boldsymbol\Omega(0)` in the
+        body frame.
+    m0 : array_like, shape (..., 3), optional
+        Initial spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`.
+        Exactly one of ``omega0`` and ``m0``.
+    attitude0 : Attitude or array_like, shape (..., 4), optional
+        Initial attitude (unit quaternion); the identity by default, as for
+        the paper's trajectories through the unit of SO(3) (eq. 1.2).
+    method : str
+        A name from :func:`available_methods`: ``"exact"`` (closed form,
+        default) and the integrators.
+    **options
+        Method options (e.g. ``tol`` or ``dt``); unknown ones raise TypeError.
+
+    Returns
+    -------
+    Trajectory
+        Times, attitudes, angular velocities and integrals.
+
+    Raises
+    ------
+    TypeError
+        Neither or both of ``omega0``/``m0``; an unknown option.
+    InvalidInputError
+        Unknown method, bad shapes, NaN/inf, a non-unit quaternion.
+    InvalidInertiaError
+        A non-physical inertia tensor.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> tr = ep.solve([1.0, 2.0, 3.0], [0.0, 1.0, 10.0], omega0=[1.0, 0.1, 0.5])
+    >>> tr.omega.shape
+    (3, 3)
+    """
+    cls = get_method(method)
+    m = cls(**options)
+    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0)
+    if not cls.negative_times and np.any(problem.t < 0):
+        raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
+    start = _time.perf_counter()
+    res = m.run(problem)
+    wall = _time.perf_counter() - start
+    stats = {"wall_time": wall, **res.stats}
+    return Trajectory(
+        t=problem.t,
+        quaternion=res.q,
+        omega=res.omega,
+        body=problem.body,
+        method=method,
+        options=dict(m.config),
+        stats=stats,
+    )
+
+

@@ -1,0 +1,1354 @@
+r"""Compiled scalar kernels of the closed-form free rigid body (private).
+
+This module is a scalar transcription of the vectorized NumPy implementation
+in :mod:`eulerpoisson.solvers.exact.motion` and :mod:`eulerpoisson.numerics.elliptic` (Jacobi
+elliptic functions by a double-double reduction modulo the quarter period and
+the descending Landen transformation, Carlson's ``R_F`` and ``R_J`` by
+duplication, Jacobi's addition theorem for the integral of the third kind;
+see those modules for the mathematics and the references).  The numerical
+method is *the same*: every floating-point operation is performed in the same
+order on the same operands, only per element instead of per array.  The
+kernels are compiled with numba (``@njit(cache=True)``,
+``error_model="numpy"`` so that IEEE semantics hold, no ``fastmath``: no
+contraction into fused multiply-adds, which would break the error-free
+transformations of the double-double arithmetic; the only explicit fused
+multiply-add forms the exact error of a product inside the AGM, where it is
+bitwise equal to Dekker's product, see :func:`_two_prod_f`).
+
+Consequences:
+
+* with the same elementary functions (``sin``, ``atan``, ``log1p``, ... from
+  the C library) the compiled path reproduces the NumPy path *bitwise*; NumPy
+  may use its own SIMD implementations of some of them (e.g. AVX-512 builds
+  of ``exp``, ``tanh``, ``atan``), which differ by 1-3 ulp, so in general the
+  two paths agree to a few ulp of the intermediate quantities;
+* memory is O(1) per body: the per-body constants live in a small work array
+  that is reused, so ``nb`` bodies times ``T`` times cost
+  ``nb * (setup + T * evaluation)`` with no intermediate arrays.
+
+Speed comes from doing only the work an output needs (the complete
+integrals ``J_c``, the values at ``tau0`` and ``J(tau0)`` are computed on
+first use, so a body evaluated once pays only for the branch it takes) and
+from running independent iterations interleaved (their latency chains
+overlap): the AGM for ``K``, the Landen chain and the ``R_F`` of the initial
+phase in one loop (:func:`_params`); the Jacobi functions at ``tau``,
+``tau0`` and ``lambda t`` in one Landen ascent (:func:`_sncndn3`); up to
+three ``R_J`` (at ``tau``, at ``tau0`` and the complete one) in one
+duplication loop (:func:`_rj3`).  Each interleaved iteration keeps its own
+stopping rule, so the results are those of the stand-alone algorithms, bit
+for bit.  The per-(body, time) cost is dominated by the ``R_J`` duplication
+(an ``atan`` per step) and the Landen ascent; the per-body one by the AGM.
+
+Layout: :func:`body_setup` computes the per-body constants (sorting to
+ascending moments by a proper signed permutation, exact power-of-two scaling,
+regime, elliptic parameter, Landen chain, initial phase) into a float64 array
+``cst`` (indices ``_C_*``, the Landen levels included);
+:func:`body_eval` evaluates ``M`` and the attitude quaternion at one time;
+:func:`motion_kernel` and :func:`constants_kernel` are the two compiled entry
+points (one signature each).
+
+The compiled kernels are used when numba imports and the environment variable
+``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
+module, :data:`USE_NUMBA`); otherwise :mod:`eulerpoisson.solvers.exact.motion` runs its
+NumPy path (the reference).  The functions here are plain Python when numba
+is not used (correct, bitwise equal, but slow; not used by the package then).
+
+References
+----------
+.. [1] B. C. Carlson, "Numerical computation of real or complex elliptic
+   integrals", Numer. Algorithms 10 (1995) 13-26.
+.. [2] T. J. Dekker, "A floating-point technique for extending the available
+   precision", Numer. Math. 18 (1971) 224-242.
+.. [3] DLMF chapters 19 and 22, https://dlmf.nist.gov/.
+.. [4] E. Celledoni, F. Fassò, N. Säfström, A. Zanna, "The exact computation
+   of the free rigid body motion and its use in splitting methods", SIAM J.
+   Sci. Comput. 30 (2008) 2084-2112.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "USE_NUMBA",
+    "N_CONST",
+    "MAX_LANDEN",
+    "body_setup",
+    "body_eval",
+    "motion_kernel",
+    "constants_kernel",
+]
+
+
+from ...numerics.doubledouble import dd_add as _dd_add
+from ...numerics.doubledouble import dd_mul as _dd_mul
+from ...numerics.doubledouble import quick_two_sum as _quick_two_sum
+from ...numerics.doubledouble import split as _split
+from ...numerics.doubledouble import two_prod as _two_prod
+from ...numerics.doubledouble import two_sum as _two_sum
+from ...numerics.quaternion import qmul_components as _qmul
+from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
+
+# --- numerical constants: identical to those of numerics.elliptic / motion ----------
+_PI_HI = 3.141592653589793
+_PI_LO = 1.2246467991473532e-16
+_PIO2_HI = 1.5707963267948966
+_PIO2_LO = 6.123233995736766e-17
+_LANDEN_THRESHOLD = 2.0**-56
+#: maximum number of Landen levels (as in numerics.elliptic; about 5 are ever used)
+MAX_LANDEN = 40
+_MAX_AGM = 60
+_MAX_DUPLICATION = 200
+_R_TOL = 2.0**-53
+_RF_QFAC = (3.0 * _R_TOL) ** (-1.0 / 6.0)
+_RDJ_QFAC = (0.25 * _R_TOL) ** (-1.0 / 6.0)
+_M1_SEPARATRIX = 1e-200
+_TWO200 = 2.0**200
+_TWOM100 = 2.0**-100
+_TWOM104 = 2.0**-104
+_HALF_PI = 0.5 * np.pi
+
+# regime codes (as in motion)
+_EQUILIBRIUM = 0
+_REGIME_A = 1
+_REGIME_B = 2
+_SEPARATRIX = 3
+
+# --- layout of the per-body constants array ----------------------------------
+_C_REGIME = 0
+_C_CASEB = 1  # 1.0 regime B (circulation about the largest-moment axis)
+_C_SEP = 2  # 1.0 on the separatrix
+_C_M = 3
+_C_M1 = 4
+_C_KP = 5  # sqrt(m1)
+_C_KH = 6  # K (pi/2 on the separatrix), double-double
+_C_KL = 7
+_C_PH = 8  # prod(1 + sqrt(p_i)) of the Landen chain, ph * (1 + pcorr)
+_C_PCORR = 9
+_C_LAM = 10
+_C_T0H = 11  # tau0, double-double
+_C_T0L = 12
+_C_AC = 13
+_C_A2 = 14
+_C_AA = 15
+_C_SA = 16
+_C_SC = 17
+_C_RATE = 18
+_C_COEF = 19
+_C_NU = 20
+_C_OMNU = 21
+_C_JC = 22  # lazy
+_C_NADD = 23
+_C_CADD = 24
+_C_NUD = 25
+_C_OMNUD = 26
+_C_JCD = 27  # lazy
+_C_G0 = 28
+_C_TSCALE = 29  # 2**escale, or 0 where not a normal number (then ldexp)
+_C_SN0 = 30  # lazy (with the values at tau0)
+_C_JFAR0 = 31  # lazy
+_C_THETA0 = 32  # lazy (with the values at tau0)
+_C_KFULL = 33
+_C_Q0W = 34
+_C_Q0X = 35
+_C_Q0Y = 36
+_C_Q0Z = 37
+_C_PERM0 = 38  # perm[k] as float, k = 0, 1, 2
+_C_SGN0 = 41  # sgn[k]
+_C_EM = 44  # exponent of the M scaling
+_C_ESCALE = 45  # exponent of the time scaling
+_C_NLEV = 46  # number of Landen levels
+_C_M0S = 47  # sorted, signed, *unscaled* M0 (3 entries; exact output at t = 0)
+_C_MSCALE = 50  # 2**eM, or 0 where not a normal number
+_C_TAU0V = 53  # n, r, s, c, d of the reduced tau0 (5 entries; lazy)
+_C_HAVE_JC = 58  # flags of the lazily computed constants: 1.0 once computed
+_C_HAVE_JCD = 59
+_C_HAVE_JFAR0 = 60
+_C_HAVE_T0 = 61
+_C_SQM = 62  # Landen levels sqrt(p_i) (MAX_LANDEN entries)
+_C_PCL = _C_SQM + MAX_LANDEN  # and 1 - p_i
+#: length of the per-body constants array
+N_CONST = _C_PCL + MAX_LANDEN
+
+
+# =============================================================================
+# double-double primitives (Dekker 1971), scalar
+# =============================================================================
+# Variants with the exact product ``a*b - fl(a*b)`` formed by a fused
+# multiply-add when compiled.  Without underflow of the error term Dekker's
+# product is exact as well, so both give the same bits; they are used only
+# in the AGM, whose operands are >= 1e-100 (m1 >= 1e-200 and the 2**200
+# scaling), where that holds.  The plain-Python version is Dekker's.
+def _two_prod_f(a, b):
+    return _two_prod(a, b)
+
+
+def _dd_mul_f(ah, al, bh, bl):
+    p, e = _two_prod_f(ah, bh)
+    e = e + (ah * bl + al * bh)
+    return _quick_two_sum(p, e)
+
+
+def _dd_mul_d_f(ah, al, b):
+    p, e = _two_prod_f(ah, b)
+    e = e + al * b
+    return _quick_two_sum(p, e)
+
+
+def _dd_div_f(ah, al, bh, bl):
+    q1 = ah / bh
+    ph, pl = _dd_mul_d_f(bh, bl, q1)
+    rh, rl = _dd_add(ah, al, -ph, -pl)
+    q2 = rh / bh
+    ph, pl = _dd_mul_d_f(bh, bl, q2)
+    rh, rl = _dd_add(rh, rl, -ph, -pl)
+    q3 = rh / bh
+    q1, q2 = _quick_two_sum(q1, q2)
+    return _dd_add(q1, q2, q3, 0.0 * q3)
+
+
+def _dd_sqrt_f(ah, al):
+    x = math.sqrt(ah)
+    if x > 0.0:
+        p, e = _two_prod_f(x, x)
+        corr = ((ah - p) - e + al) / (2.0 * x)
+    else:
+        corr = 0.0
+    return _quick_two_sum(x, corr)
+
+
+def _pow2(k):
+    """``2**k`` for ``-1022 <= k <= 1023`` (a normal number), else 0."""
+    if -1022 <= k <= 1023:
+        return math.ldexp(1.0, k)
+    return 0.0
+
+
+def _ldexp(x, f, k):
+    """``ldexp(x, k)`` given ``f = _pow2(k)``: one correctly rounded product."""
+    if f != 0.0:
+        return x * f
+    return math.ldexp(x, k)
+
+
+# =============================================================================
+# Carlson integrals (duplication; same truncation as _elliptic)
+# =============================================================================
+def _rf_poly(a0, x0, y0, a, fac):
+    """Truncated series of ``R_F`` after the duplication (DLMF 19.36.1)."""
+    X = (a0 - x0) * fac / a
+    Y = (a0 - y0) * fac / a
+    Z = -(X + Y)
+    e2 = X * Y - Z * Z
+    e3 = X * Y * Z
+    poly = (
+        1.0
+        - e2 / 10.0
+        + e3 / 14.0
+        + e2 * e2 / 24.0
+        - 3.0 * e2 * e3 / 44.0
+        - 5.0 * e2 * e2 * e2 / 208.0
+        + 3.0 * e3 * e3 / 104.0
+        + e2 * e2 * e3 / 16.0
+    )
+    return poly / math.sqrt(a)
+
+
+def _rc1(e, sp, p, lam, d):
+    """``R_C(1, 1 + e)`` (``elliptic._rc1``); ``1 + e = 2 sqrt(p) (p + lam) / d``
+    is formed only where it is used (``e < 0``)."""
+    t = math.sqrt(abs(e))
+    if e > 0.0:
+        return math.atan(t) / t
+    if e < 0.0:
+        y = 2.0 * sp * (p + lam) / d
+        return 0.5 * math.log1p(2.0 * t * (1.0 + t) / y) / t
+    return 1.0
+
+
+def _rj_init(x0, y0, z0, p0):
+    """``(A_0, delta, sc, Q)`` of the ``R_J`` duplication (``delta, sc`` as ``elliptic._rj_delta``)."""
+    a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0
+    f1 = p0 - x0
+    f2 = p0 - y0
+    f3 = p0 - z0
+    delta = f1 * f2 * f3
+    sc = 1.0
+    if abs(delta) < 2.0**-960 and f1 != 0.0 and f2 != 0.0 and f3 != 0.0:
+        e1 = -math.frexp(f1)[1] if abs(f1) < 0.5 else 0
+        e2 = -math.frexp(f2)[1] if abs(f2) < 0.5 else 0
+        e1 = e1 + (e1 + e2) % 2
+        delta = math.ldexp(f1, e1) * math.ldexp(f2, e2) * f3
+        sc = math.ldexp(1.0, (e1 + e2) // 2)
+    q = _RDJ_QFAC * max(max(abs(a0 - x0), abs(a0 - y0)), max(abs(a0 - z0), abs(a0 - p0)))
+    return a0, delta, sc, q
+
+
+def _rj_step(a, fac, x, y, z, p, acc, delta, sc):
+    """One duplication step of ``R_J`` with its ``R_C`` term (``elliptic._rj_step``)."""
+    sx = math.sqrt(x)
+    sy = math.sqrt(y)
+    sz = math.sqrt(z)
+    sp = math.sqrt(p)
+    lam = sx * sy + sy * sz + sz * sx
+    d = (sp + sx) * (sp + sy) * (sp + sz)
+    dd = d * sc
+    e = (fac * fac * fac) * delta / (dd * dd)
+    acc = acc + fac * _rc1(e, sp, p, lam, d) / d
+    return (
+        0.25 * (a + lam),
+        0.25 * fac,
+        0.25 * (x + lam),
+        0.25 * (y + lam),
+        0.25 * (z + lam),
+        0.25 * (p + lam),
+        acc,
+    )
+
+
+def _rj_finish(a0, x0, y0, z0, a, fac, acc):
+    """Truncated series after the duplication (DLMF 19.36.ii)."""
+    X = (a0 - x0) * fac / a
+    Y = (a0 - y0) * fac / a
+    Z = (a0 - z0) * fac / a
+    P = -(X + Y + Z) / 2.0
+    xyz = X * Y * Z
+    p2 = P * P
+    e2 = X * Y + X * Z + Y * Z - 3.0 * p2
+    e3 = xyz + 2.0 * e2 * P + 4.0 * p2 * P
+    e4 = (2.0 * xyz + e2 * P + 3.0 * p2 * P) * P
+    e5 = xyz * p2
+    poly = (
+        1.0
+        - 3.0 * e2 / 14.0
+        + e3 / 6.0
+        + 9.0 * e2 * e2 / 88.0
+        - 3.0 * e4 / 22.0
+        - 9.0 * e2 * e3 / 52.0
+        + 3.0 * e5 / 26.0
+    )
+    return fac * poly / (a * math.sqrt(a)) + 6.0 * acc
+
+
+def _rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
+    """Up to three independent ``R_J`` values (lanes ``on_*``), duplications interleaved.
+
+    Every lane performs exactly the operations of ``elliptic._rj`` and stops
+    by its own criterion.  Lanes that are off return 0.
+    """
+    a0a, dla, sca, qa = _rj_init(xa, ya, za, pa)
+    a0b, dlb, scb, qb = _rj_init(xb, yb, zb, pb)
+    a0c, dlc, scc, qc = _rj_init(xc, yc, zc, pc)
+    A_a, fa, x_a, y_a, z_a, p_a, ca = a0a, 1.0, xa, ya, za, pa, 0.0
+    A_b, fb, x_b, y_b, z_b, p_b, cb = a0b, 1.0, xb, yb, zb, pb, 0.0
+    A_c, fc, x_c, y_c, z_c, p_c, cc = a0c, 1.0, xc, yc, zc, pc, 0.0
+    run_a = on_a
+    run_b = on_b
+    run_c = on_c
+    for _ in range(_MAX_DUPLICATION):
+        if run_a:
+            if fa * qa >= abs(A_a):
+                A_a, fa, x_a, y_a, z_a, p_a, ca = _rj_step(A_a, fa, x_a, y_a, z_a, p_a, ca, dla, sca)
+            else:
+                run_a = False
+        if run_b:
+            if fb * qb >= abs(A_b):
+                A_b, fb, x_b, y_b, z_b, p_b, cb = _rj_step(A_b, fb, x_b, y_b, z_b, p_b, cb, dlb, scb)
+            else:
+                run_b = False
+        if run_c:
+            if fc * qc >= abs(A_c):
+                A_c, fc, x_c, y_c, z_c, p_c, cc = _rj_step(A_c, fc, x_c, y_c, z_c, p_c, cc, dlc, scc)
+            else:
+                run_c = False
+        if not (run_a or run_b or run_c):
+            break
+    ra = _rj_finish(a0a, xa, ya, za, A_a, fa, ca) if on_a else 0.0
+    rb = _rj_finish(a0b, xb, yb, zb, A_b, fb, cb) if on_b else 0.0
+    rc = _rj_finish(a0c, xc, yc, zc, A_c, fc, cc) if on_c else 0.0
+    return ra, rb, rc
+
+
+# =============================================================================
+# parameter set-up: K (AGM in double-double), Landen chain and the R_F of the
+# initial phase, interleaved
+# =============================================================================
+def _params(m, m1, rx, ry, rz, do_rf, cst):
+    """Parameter data of the Jacobi kernels into ``cst``; returns ``R_F(rx, ry, rz)``.
+
+    Three independent iterations run interleaved in one loop, each with its
+    own stopping rule and iteration limit, so that their latency chains
+    overlap; each performs exactly the operations of its stand-alone version:
+    the AGM for ``K`` in double-double (``elliptic._ellipk_dd``), the
+    descending Landen chain (``elliptic._jacobi_params``) and the duplication
+    of ``R_F`` (if ``do_rf``).  Returns the ``R_F`` value (0 if not
+    ``do_rf``).
+    """
+    kp = math.sqrt(m1)
+    sep = m1 == 0.0
+    # AGM state: a = 1, b = sqrt(m1) (double-double, scaled against underflow)
+    agm_on = not sep
+    ah = 1.0
+    al = 0.0
+    bh = 0.0
+    bl = 0.0
+    if agm_on:
+        bh, bl = _dd_sqrt_f(m1 * _TWO200, 0.0)
+        bh, bl = bh * _TWOM100, bl * _TWOM100
+    # Landen chain on p = m (real path) or p = m1 (imaginary path, m > 1/2)
+    if m > 0.5:
+        pc = m1
+        pc1 = m
+        thr = 0.25 * _LANDEN_THRESHOLD * kp
+    else:
+        pc = m
+        pc1 = m1
+        thr = _LANDEN_THRESHOLD
+    lan_on = True
+    nlev = 0
+    # R_F duplication
+    rf_on = do_rf
+    ra0 = (rx + ry + rz) / 3.0
+    rq = _RF_QFAC * max(max(abs(ra0 - rx), abs(ra0 - ry)), abs(ra0 - rz))
+    ra = ra0
+    rfac = 1.0
+    x = rx
+    y = ry
+    z = rz
+    for it in range(_MAX_DUPLICATION):
+        if agm_on:
+            if it < _MAX_AGM:
+                dh, _dl = _dd_add(ah, al, -bh, -bl)
+                if abs(dh) > _TWOM104 * ah:
+                    sh, sl = _dd_add(ah, al, bh, bl)
+                    ph, pl = _dd_mul_f(ah, al, bh, bl)
+                    bh, bl = _dd_sqrt_f(ph, pl)
+                    ah, al = 0.5 * sh, 0.5 * sl
+                else:
+                    agm_on = False
+            else:
+                agm_on = False
+        if lan_on:
+            if it < MAX_LANDEN and pc > thr:
+                kq = math.sqrt(pc1)
+                den = (1.0 + kq) * (1.0 + kq)
+                sq = pc / den
+                pn1 = 4.0 * kq / den
+                cst[_C_SQM + nlev] = sq
+                cst[_C_PCL + nlev] = pn1
+                nlev += 1
+                pc = sq * sq
+                pc1 = pn1
+            else:
+                lan_on = False
+        if rf_on:
+            if rfac * rq >= abs(ra):
+                sx = math.sqrt(x)
+                sy = math.sqrt(y)
+                sz = math.sqrt(z)
+                lam = sx * sy + sy * sz + sz * sx
+                ra = 0.25 * (ra + lam)
+                rfac = 0.25 * rfac
+                x = 0.25 * (x + lam)
+                y = 0.25 * (y + lam)
+                z = 0.25 * (z + lam)
+            else:
+                rf_on = False
+        if not (agm_on or lan_on or rf_on):
+            break
+    if sep:
+        kh = _PIO2_HI
+        kl = _PIO2_LO
+    else:
+        kh, kl = _dd_div_f(_PI_HI, _PI_LO, ah, al)
+        kh = 0.5 * kh
+        kl = 0.5 * kl
+    ph = 1.0
+    pl = 0.0
+    for i in range(nlev):
+        oh, ol = _two_sum(1.0, cst[_C_SQM + i])
+        ph, pl = _dd_mul(ph, pl, oh, ol)
+    cst[_C_KP] = kp
+    cst[_C_KH] = kh
+    cst[_C_KL] = kl
+    cst[_C_PH] = ph
+    cst[_C_PCORR] = pl / ph
+    cst[_C_NLEV] = nlev
+    if do_rf:
+        return _rf_poly(ra0, rx, ry, ra, rfac)
+    return 0.0
+
+
+# =============================================================================
+# Jacobi elliptic functions of double-double arguments, up to three at once
+# (``elliptic._sncndn_dd``: reduction modulo K, Landen ascent, quarter map)
+# =============================================================================
+def _sech(x):
+    e = math.exp(-abs(x))
+    return 2.0 * e / (1.0 + e * e)
+
+
+def _reduce(uh, ul, sep, kh, kl, ph, pcorr):
+    """``u = n K + r``; returns ``n, r, neg, v = |r|, vn, dv`` (argument at the chain's bottom)."""
+    n = 0.0 if sep else np.rint(uh / kh)
+    p, pe = _two_prod(n, kh)
+    t = uh - p
+    rh, rl = _two_sum(t, -pe)
+    rl = rl + (ul - n * kl)
+    r, rl = _quick_two_sum(rh, rl)
+    neg = r < 0.0
+    v = abs(r)
+    vl = -rl if neg else rl
+    vq = v / ph
+    vn = vq - vq * pcorr
+    dv = vl / ph
+    return n, r, neg, v, vn, dv
+
+
+def _real_start(vn, dv):
+    s0 = math.sin(vn)
+    c0 = math.cos(vn)
+    h = math.sin(0.5 * vn)
+    return s0 + c0 * dv, c0 - s0 * dv, 2.0 * h * h + s0 * dv
+
+
+def _real_level(s, c, y, sq, pc):
+    """One Landen step up on the real axis, carrying ``y = 1 - cn``."""
+    s2 = s * s
+    ce = 1.0 - y if y < 0.5 else c
+    d = math.sqrt(ce * ce + pc * s2)
+    den = 1.0 + sq * s2
+    s_new = (1.0 + sq) * s / den
+    c_new = ce * d / den
+    y_new = (y + ce * (sq * sq * s2) / (1.0 + d) + sq * s2) / den
+    return s_new, c_new, y_new
+
+
+def _imag_start(vn, dv):
+    sh = math.sinh(vn)
+    ch = math.cosh(vn)
+    return sh + ch * dv, ch + sh * dv
+
+
+def _imag_level(sig, C, sq):
+    """One Landen step up on the imaginary axis (Jacobi's imaginary transformation)."""
+    s2 = sig * sig
+    D = math.sqrt(1.0 + (sq * sq) * s2)
+    den = 1.0 - sq * s2
+    return (1.0 + sq) * sig / den, C * D / den
+
+
+def _finish(n, r, neg, v, s, c, sep, m, m1, kp):
+    """``dn``, sign, separatrix and quarter-period map: ``(sn, cn, dn, n, r, s, c, d)``."""
+    if sep:
+        s = math.tanh(v)
+        c = _sech(v)
+        d = c
+    else:
+        s2 = s * s
+        if m <= 0.5:
+            d = math.sqrt(1.0 - m * s2)
+        else:
+            d = math.sqrt(c * c + m1 * s2)
+    if neg:
+        s = -s
+    q = n % 4.0
+    if q == 1.0 or q == 3.0:
+        sn = c / d
+        cn = -(kp * s / d)
+        dn = kp / d
+    else:
+        sn = s
+        cn = c
+        dn = d
+    if q >= 2.0:
+        sn = -sn
+        cn = -cn
+    return sn, cn, dn, n, r, s, c, d
+
+
+def _sncndn3(k, u1h, u1l, u2h, u2l, u3h, u3l, cst):
+    """Jacobi functions at ``k`` (1 to 3) double-double arguments, ascents interleaved.
+
+    Returns ``(sn, cn, dn, n, r, s, c, d)`` of each of the three lanes (a
+    24-tuple; lanes beyond ``k`` are zeros): the values at ``u``, the
+    quarter-period index ``n``, the reduced argument ``r`` and the values at
+    ``r``, exactly as ``elliptic._sncndn_dd``.
+    """
+    sep = cst[_C_SEP] != 0.0
+    kh = cst[_C_KH]
+    kl = cst[_C_KL]
+    ph = cst[_C_PH]
+    pcorr = cst[_C_PCORR]
+    m = cst[_C_M]
+    m1 = cst[_C_M1]
+    kp = cst[_C_KP]
+    nlev = int(cst[_C_NLEV])
+    two = k >= 2
+    three = k >= 3
+    n1, r1, ng1, v1, vn1, dv1 = _reduce(u1h, u1l, sep, kh, kl, ph, pcorr)
+    n2 = r2 = v2 = vn2 = dv2 = 0.0
+    n3 = r3 = v3 = vn3 = dv3 = 0.0
+    ng2 = ng3 = False
+    if two:
+        n2, r2, ng2, v2, vn2, dv2 = _reduce(u2h, u2l, sep, kh, kl, ph, pcorr)
+    if three:
+        n3, r3, ng3, v3, vn3, dv3 = _reduce(u3h, u3l, sep, kh, kl, ph, pcorr)
+    s1 = c1 = s2 = c2 = s3 = c3 = 0.0
+    if not sep:
+        if m > 0.5:
+            g1, C1 = _imag_start(vn1, dv1)
+            g2 = C2 = g3 = C3 = 1.0
+            if two:
+                g2, C2 = _imag_start(vn2, dv2)
+            if three:
+                g3, C3 = _imag_start(vn3, dv3)
+            for i in range(nlev - 1, -1, -1):
+                sq = cst[_C_SQM + i]
+                if sq > 0.0:
+                    g1, C1 = _imag_level(g1, C1, sq)
+                    if two:
+                        g2, C2 = _imag_level(g2, C2, sq)
+                    if three:
+                        g3, C3 = _imag_level(g3, C3, sq)
+            s1, c1 = g1 / C1, 1.0 / C1
+            if two:
+                s2, c2 = g2 / C2, 1.0 / C2
+            if three:
+                s3, c3 = g3 / C3, 1.0 / C3
+        else:
+            s1, c1, y1 = _real_start(vn1, dv1)
+            y2 = y3 = 0.0
+            if two:
+                s2, c2, y2 = _real_start(vn2, dv2)
+            if three:
+                s3, c3, y3 = _real_start(vn3, dv3)
+            for i in range(nlev - 1, -1, -1):
+                sq = cst[_C_SQM + i]
+                if sq > 0.0:
+                    pc = cst[_C_PCL + i]
+                    s1, c1, y1 = _real_level(s1, c1, y1, sq, pc)
+                    if two:
+                        s2, c2, y2 = _real_level(s2, c2, y2, sq, pc)
+                    if three:
+                        s3, c3, y3 = _real_level(s3, c3, y3, sq, pc)
+            if y1 < 0.5:
+                c1 = 1.0 - y1
+            if two and y2 < 0.5:
+                c2 = 1.0 - y2
+            if three and y3 < 0.5:
+                c3 = 1.0 - y3
+    a1, b1, e1, f1, g1_, h1, i1, j1 = _finish(n1, r1, ng1, v1, s1, c1, sep, m, m1, kp)
+    a2 = b2 = e2 = f2 = g2_ = h2 = i2 = j2 = 0.0
+    a3 = b3 = e3 = f3 = g3_ = h3 = i3 = j3 = 0.0
+    if two:
+        a2, b2, e2, f2, g2_, h2, i2, j2 = _finish(n2, r2, ng2, v2, s2, c2, sep, m, m1, kp)
+    if three:
+        a3, b3, e3, f3, g3_, h3, i3, j3 = _finish(n3, r3, ng3, v3, s3, c3, sep, m, m1, kp)
+    return (
+        a1, b1, e1, f1, g1_, h1, i1, j1,
+        a2, b2, e2, f2, g2_, h2, i2, j2,
+        a3, b3, e3, f3, g3_, h3, i3, j3,
+    )
+
+
+# =============================================================================
+# rigid-body pieces (see motion: _jtot, _theta, _jfar, _jsep, _near, _qmin)
+# =============================================================================
+def _jtot_args(nu, omnu, n, s, c, d, kp):
+    """Arguments of the ``R_J`` in ``J(nu; nK + r)``: ``(odd, S, S^2, C^2, D^2, p)``."""
+    odd = n % 2.0 == 1.0
+    sa_ = abs(s)
+    if odd:
+        S = c / d
+        C = kp * sa_ / d
+        Dd = kp / d
+    else:
+        S = sa_
+        C = c
+        Dd = d
+    S2 = S * S
+    C2 = C * C
+    if nu <= 0.0:
+        p = 1.0 - nu * S2
+    else:
+        p = omnu + nu * C2
+    return odd, S, S2, C2, Dd * Dd, p
+
+
+def _jtot_from(odd, n, r, jc, S, S2, rj):
+    """``J = n J_c + J_per`` from the ``R_J`` value (not used where ``S^2 = 0``)."""
+    if S2 > 0.0:
+        jq = S * S2 * rj / 3.0
+    else:
+        jq = 0.0
+    if odd:
+        sg = 1.0 if r > 0.0 else (-1.0 if r < 0.0 else 0.0)
+        jper = sg * (jc - jq)
+    else:
+        jper = -jq if r < 0.0 else jq
+    # n = +-0 is the only case in which a caller may pass a placeholder
+    # jc > 0 (not computed yet): n * jc = n exactly there
+    nj = n * jc if n != 0.0 else n
+    return nj + jper
+
+
+def _jtot(nu, omnu, jc, n, r, s, c, d, kp):
+    """``J(nu; nK + r) = int_0^u sn^2/(1 - nu sn^2)`` from the values ``s, c, d``
+    at ``r`` (``motion._jtot`` for one element, not on the separatrix)."""
+    odd, S, S2, C2, D2, p = _jtot_args(nu, omnu, n, s, c, d, kp)
+    if S2 > 0.0:
+        rj, _, _ = _rj3(C2, D2, 1.0, p, True, 0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False)
+    else:
+        rj = 0.0
+    return _jtot_from(odd, n, r, jc, S, S2, rj)
+
+
+def _get_jc(cst):
+    """Complete ``J_c = R_J(0, m1, 1, 1 - nu) / 3`` (0 on the separatrix), on first use."""
+    if cst[_C_HAVE_JC] == 0.0:
+        if cst[_C_SEP] != 0.0:
+            cst[_C_JC] = 0.0
+        else:
+            rj, _, _ = _rj3(
+                0.0, cst[_C_M1], 1.0, cst[_C_OMNU], True,
+                0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False,
+            )
+            cst[_C_JC] = rj / 3.0
+        cst[_C_HAVE_JC] = 1.0
+    return cst[_C_JC]
+
+
+def _get_jcd(cst):
+    """Complete integral of the direct form of ``G`` (regime B; ``J_c`` in A), on first use."""
+    if cst[_C_CASEB] == 0.0:
+        return _get_jc(cst)
+    if cst[_C_HAVE_JCD] == 0.0:
+        rj, _, _ = _rj3(
+            0.0, cst[_C_M1], 1.0, cst[_C_OMNUD], True,
+            0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False,
+        )
+        cst[_C_JCD] = rj / 3.0
+        cst[_C_HAVE_JCD] = 1.0
+    return cst[_C_JCD]
+
+
+def _theta(cst, n, s, c):
+    """Unwrapped azimuth ``n pi/2 + dtheta`` of ``M`` about the circled axis (``motion._theta``)."""
+    if n % 2.0 == 1.0:
+        dtheta = math.atan2(cst[_C_AC] * cst[_C_KP] * s, cst[_C_A2] * c)
+    else:
+        dtheta = math.atan2(cst[_C_A2] * s, cst[_C_AC] * c)
+    return (n % 8.0) * _HALF_PI + dtheta
+
+
+def _jsep(N, tau):
+    """Separatrix ``J = (tau - atan(sqrt(N) tanh tau)/sqrt(N)) / (1 + N)``."""
+    rN = math.sqrt(N)
+    tt = math.tanh(tau)
+    z = rN * tt
+    if z != 0.0:
+        at = math.atan(z) / z * tt
+    else:
+        at = 1.0 * tt
+    return (tau - at) / (1.0 + N)
+
+
+def _near(cst, dh, dl, sn_tau, snd, cnd, dnd, n, r, s, c, d):
+    """Increment ``J(tau) - J(tau0)`` (A) or ``G(tau) - G(tau0)`` (B) for
+    ``|lambda t| <= K`` by Jacobi's addition theorem (``motion._near``);
+    ``snd ... d``: the Jacobi functions at ``delta = lambda t = dh + dl``."""
+    N = cst[_C_NADD]
+    Pp = sn_tau * cst[_C_SN0]
+    X = 1.0 + N * snd * snd + N * Pp * cnd * dnd
+    Y = -Pp * snd
+    z = cst[_C_CADD] * Y / X
+    if z != 0.0:
+        atanc = math.atan(z) / z
+    else:
+        atanc = 1.0
+    xadd = -(Y / X) * atanc
+    dlt = dh + dl
+    caseB = cst[_C_CASEB] != 0.0
+    g0 = cst[_C_G0]
+    use_sh = caseB and (abs(dlt) * g0 > cst[_C_M1] * _get_jc(cst))
+    if cst[_C_SEP] != 0.0:
+        jd = _jsep(N, dlt)
+    elif use_sh:
+        nn = n - 1.0
+        jc = 1.0 if nn == 0.0 else _get_jc(cst)
+        jd = _jtot(cst[_C_NU], cst[_C_OMNU], jc, nn, r, s, c, d, cst[_C_KP])
+    else:
+        jc = 1.0 if n == 0.0 else _get_jcd(cst)
+        jd = _jtot(cst[_C_NUD], cst[_C_OMNUD], jc, n, r, s, c, d, cst[_C_KP])
+    if caseB:
+        if use_sh:
+            gdel = cst[_C_M1] * _get_jc(cst) + cst[_C_M1] * jd
+        else:
+            gdel = g0 * (dlt - g0 * jd)
+        return gdel - g0 * g0 * xadd
+    return jd + xadd
+
+
+def _far(cst, n, r, s, c, d):
+    """``J_far(tau) - J_far(tau0)`` for ``|lambda t| > K`` (``motion._jfar``;
+    never on the separatrix, where ``K`` is infinite).
+
+    ``J_far`` is ``J(nu_A; tau)`` (A) or ``m1 J(nu_B; tau - K)`` (B).  On the
+    first far evaluation of a body ``J_c`` and ``J_far(tau0)`` may still be
+    missing: their ``R_J`` run interleaved with the one at ``tau``.
+    """
+    caseB = cst[_C_CASEB] != 0.0
+    nu = cst[_C_NU]
+    omnu = cst[_C_OMNU]
+    kp = cst[_C_KP]
+    m1 = cst[_C_M1]
+    neff = n - 1.0 if caseB else n
+    odd, S, S2, C2, D2, p = _jtot_args(nu, omnu, neff, s, c, d, kp)
+    do0 = cst[_C_HAVE_JFAR0] == 0.0
+    doc = cst[_C_HAVE_JC] == 0.0
+    k = _C_TAU0V
+    n0 = cst[k]
+    r0 = cst[k + 1]
+    neff0 = n0 - 1.0 if caseB else n0
+    odd0, S0, S20, C20, D20, p0 = _jtot_args(nu, omnu, neff0, cst[k + 2], cst[k + 3], cst[k + 4], kp)
+    rjt, rj0, rjc = _rj3(
+        C2, D2, 1.0, p, S2 > 0.0,
+        C20, D20, 1.0, p0, do0 and S20 > 0.0,
+        0.0, m1, 1.0, omnu, doc,
+    )
+    if doc:
+        cst[_C_JC] = rjc / 3.0
+        cst[_C_HAVE_JC] = 1.0
+    jc = cst[_C_JC]
+    if do0:
+        j0 = _jtot_from(odd0, neff0, r0, jc, S0, S20, rj0)
+        cst[_C_JFAR0] = m1 * j0 if caseB else j0
+        cst[_C_HAVE_JFAR0] = 1.0
+    j = _jtot_from(odd, neff, r, jc, S, S2, rjt)
+    if caseB:
+        j = m1 * j
+    return j - cst[_C_JFAR0]
+
+
+def _qmin(M1, M2, M3, caseB, sa):
+    """Quaternion of the minimal rotation taking ``M/|M|`` to ``sa e_3`` (B) / ``sa e_1`` (A)."""
+    nrm = math.sqrt(M1 * M1 + M2 * M2 + M3 * M3)
+    x = M1 / nrm
+    y = M2 / nrm
+    z = M3 / nrm
+    if caseB:
+        ze = sa * z
+        vx = sa * y
+        vy = -sa * x
+        vz = 0.0
+    else:
+        ze = sa * x
+        vx = 0.0
+        vy = sa * z
+        vz = -sa * y
+    w = 1.0 + ze
+    f = 1.0 / math.sqrt(2.0 * w)
+    return w * f, vx * f, vy * f, vz * f
+
+
+# =============================================================================
+# per-body set-up
+# =============================================================================
+def body_setup(i0, i1, i2, m0, m1_, m2, cst):
+    """Per-body constants of the closed-form solution into ``cst``.
+
+    Scalar version of ``motion._prepare`` and ``motion._constants``.
+
+    Parameters
+    ----------
+    i0, i1, i2 : float
+        Principal moments (input axis order, all > 0, finite).
+    m0, m1_, m2 : float
+        Initial body angular momentum (input axis order, finite).
+    cst : ndarray, shape (N_CONST,)
+        Output: constants (indices ``_C_*``; the Landen levels ``sqrt(p_i)``
+        and ``1 - p_i`` at ``_C_SQM`` and ``_C_PCL``).
+
+    Returns
+    -------
+    bool
+        True for a relative equilibrium (only the sorting data of ``cst`` is
+        filled then).
+    """
+    # --- proper signed permutation to ascending moments (stable argsort) ---
+    v = (i0, i1, i2)
+    p0, p1, p2 = 0, 1, 2
+    if v[p1] < v[p0]:
+        p0, p1 = p1, p0
+    if v[p2] < v[p1]:
+        p1, p2 = p2, p1
+        if v[p1] < v[p0]:
+            p0, p1 = p1, p0
+    inv = (1 if p0 > p1 else 0) + (1 if p0 > p2 else 0) + (1 if p1 > p2 else 0)
+    s1 = -1.0 if inv % 2 == 1 else 1.0
+    mv = (m0, m1_, m2)
+    I1u = v[p0]
+    I2u = v[p1]
+    I3u = v[p2]
+    M1u = 1.0 * mv[p0]
+    M2u = s1 * mv[p1]
+    M3u = 1.0 * mv[p2]
+    cst[_C_PERM0] = p0
+    cst[_C_PERM0 + 1] = p1
+    cst[_C_PERM0 + 2] = p2
+    cst[_C_SGN0] = 1.0
+    cst[_C_SGN0 + 1] = s1
+    cst[_C_SGN0 + 2] = 1.0
+    cst[_C_M0S] = M1u
+    cst[_C_M0S + 1] = M2u
+    cst[_C_M0S + 2] = M3u
+    # --- exact power-of-two scaling: max |M| and max I in [0.5, 1) ---
+    mmax = max(max(abs(M1u), abs(M2u)), abs(M3u))
+    eM = 0 if mmax == 0.0 else math.frexp(mmax)[1]
+    eI = math.frexp(I3u)[1]
+    fM = _pow2(-eM)
+    fI = _pow2(-eI)
+    M1 = _ldexp(M1u, fM, -eM)
+    M2 = _ldexp(M2u, fM, -eM)
+    M3 = _ldexp(M3u, fM, -eM)
+    I1 = _ldexp(I1u, fI, -eI)
+    I2 = _ldexp(I2u, fI, -eI)
+    I3 = _ldexp(I3u, fI, -eI)
+    cst[_C_EM] = eM
+    cst[_C_ESCALE] = eM - eI
+    cst[_C_MSCALE] = _pow2(eM)
+    cst[_C_TSCALE] = _pow2(eM - eI)
+
+    # --- regime (see motion._constants) ---
+    d21 = I2 - I1
+    d32 = I3 - I2
+    d31 = I3 - I1
+    msq = M1 * M1 + M2 * M2 + M3 * M3
+    a1 = M2 * M2 * d21 / I2 + M3 * M3 * d31 / I3
+    a3 = M1 * M1 * d31 / I1 + M2 * M2 * d32 / I2
+    # D = M^2 - 2 E I2 = (M3^2 (I3-I2) I1 - M1^2 (I2-I1) I3) / (I1 I3), double-double
+    d32h, d32l = _two_sum(I3, -I2)
+    d21h, d21l = _two_sum(I2, -I1)
+    sh, sl = _two_prod(M3, M3)
+    ph, pl = _dd_mul(sh, sl, d32h, d32l)
+    p, e = _two_prod(ph, I1)
+    t3h, t3l = _quick_two_sum(p, e + pl * I1)
+    sh, sl = _two_prod(M1, M1)
+    ph, pl = _dd_mul(sh, sl, d21h, d21l)
+    p, e = _two_prod(ph, I3)
+    t1h, t1l = _quick_two_sum(p, e + pl * I3)
+    dh, _ = _dd_add(t3h, t3l, -t1h, -t1l)
+    D = dh / (I1 * I3)
+    eq = (
+        (msq == 0.0)
+        or (a1 == 0.0)
+        or (a3 == 0.0)
+        or ((dh == 0.0) and (M1 * M1 * d21 == 0.0) and (M3 * M3 * d32 == 0.0))
+    )
+    if eq:
+        cst[_C_REGIME] = _EQUILIBRIUM
+        return True
+    mn = math.sqrt(msq)
+    m1B = d31 * D / (d32 * a1)
+    caseB = (D > 0.0) and (m1B >= _M1_SEPARATRIX)
+    if caseB:
+        m = d21 * a3 / (d32 * a1)
+        m1 = m1B
+    else:
+        m = d32 * a1 / (d21 * a3)
+        m1 = d31 * (-D) / (d21 * a3)
+    sep = (not caseB) and (m1 < _M1_SEPARATRIX)
+    # make m + m1 = 1 with the smaller of the two computed directly
+    if m <= m1:
+        m1 = 1.0 - m
+    else:
+        m = 1.0 - m1
+    if sep:
+        m = 1.0
+        m1 = 0.0
+    else:  # np.clip (NaN stays NaN)
+        if m < 0.0:
+            m = 0.0
+        elif m > 1.0:
+            m = 1.0
+        if m1 < 0.0:
+            m1 = 0.0
+        elif m1 > 1.0:
+            m1 = 1.0
+
+    A1 = math.sqrt(a3 * I1 / d31)
+    A3 = math.sqrt(a1 * I3 / d31)
+    if caseB:
+        A2 = math.sqrt(a3 * I2 / d32)
+        lam = math.sqrt(d32 * a1 / (I1 * I2 * I3))
+        Ac = A1
+        Aa = A3
+        Mc0 = M1
+        Ma0 = M3
+    else:
+        A2 = math.sqrt(a1 * I2 / d21)
+        lam = math.sqrt(d21 * a3 / (I1 * I2 * I3))
+        Ac = A3
+        Aa = A1
+        Mc0 = M3
+        Ma0 = M1
+    sa = -1.0 if Ma0 < 0.0 else 1.0
+    sc = -1.0 if (sep and Mc0 < 0.0) else 1.0
+
+    # precession rates and characteristics
+    if caseB:
+        rate = mn / I2
+        coef = mn * d32 * d21 / (I2 * I2 * d31 * lam)
+        nprime = I3 * d21 / (I2 * d31)
+        omnprime = I1 * d32 / (I2 * d31)  # 1 - n'
+        Nadd = nprime / omnprime
+        nu = m + nprime * m1
+        omnu = m1 * omnprime
+    else:
+        rate = mn / I3
+        coef = mn * d32 * d31 / (I3 * I3 * d21 * lam)
+        Nadd = I1 * d32 / (I3 * d21)  # -nu_A
+        nu = -Nadd
+        omnu = I2 * d31 / (I3 * d21)
+    if not math.isfinite(coef):
+        coef = 0.0
+    if not math.isfinite(nu):
+        nu = 0.0
+    if not (math.isfinite(omnu) and omnu > 0.0):
+        omnu = 1.0
+    if not math.isfinite(Nadd):
+        Nadd = 0.0
+    Cadd = math.sqrt(Nadd * (Nadd + m) * (1.0 + Nadd))
+    g0 = 1.0 + Nadd if caseB else 1.0
+
+    # initial phase: amplitude (c0, s0) of (sc Mc/Ac, sa sc M2/A2)
+    x = sc * Mc0 / Ac
+    y = sa * sc * M2 / A2
+    h = math.hypot(x, y)
+    c0 = x / h
+    s0 = y / h
+
+    cst[_C_REGIME] = _SEPARATRIX if sep else (_REGIME_B if caseB else _REGIME_A)
+    cst[_C_CASEB] = 1.0 if caseB else 0.0
+    cst[_C_SEP] = 1.0 if sep else 0.0
+    cst[_C_M] = m
+    cst[_C_M1] = m1
+    cst[_C_NU] = nu
+    cst[_C_OMNU] = omnu
+    cst[_C_HAVE_JC] = 0.0
+    cst[_C_HAVE_JCD] = 0.0
+    cst[_C_HAVE_JFAR0] = 0.0
+    cst[_C_HAVE_T0] = 0.0
+    # F(phi0|m) = s0 R_F(c0^2, delta^2, 1), K and the Landen chain at once
+    s2 = s0 * s0
+    if m <= 0.5:
+        delta2 = 1.0 - m * s2
+    else:
+        delta2 = c0 * c0 + m1 * s2
+    rf0 = _params(m, m1, c0 * c0, delta2, 1.0, not sep, cst)
+    kh = cst[_C_KH]
+    kl = cst[_C_KL]
+    if sep:
+        t0h = math.asinh(s0 / c0)
+        t0l = 0.0
+    else:
+        F0 = s0 * rf0
+        if c0 < 0.0:
+            sg = -1.0 if s0 < 0.0 else 1.0
+            th, tl = _two_sum(sg * 2.0 * kh, -F0)
+            tl = tl + sg * 2.0 * kl
+            t0h, t0l = _quick_two_sum(th, tl)
+        else:
+            t0h = F0
+            t0l = 0.0
+
+    cst[_C_LAM] = lam
+    cst[_C_T0H] = t0h
+    cst[_C_T0L] = t0l
+    cst[_C_AC] = Ac
+    cst[_C_A2] = A2
+    cst[_C_AA] = Aa
+    cst[_C_SA] = sa
+    cst[_C_SC] = sc
+    cst[_C_RATE] = rate
+    cst[_C_COEF] = coef
+    cst[_C_NADD] = Nadd
+    cst[_C_CADD] = Cadd
+    cst[_C_G0] = g0
+    if caseB:
+        cst[_C_NUD] = -Nadd
+        cst[_C_OMNUD] = 1.0 + Nadd
+    else:
+        cst[_C_NUD] = nu
+        cst[_C_OMNUD] = omnu
+    cst[_C_KFULL] = math.inf if sep else kh
+    qw, qx, qy, qz = _qmin(M1, M2, M3, caseB, sa)
+    cst[_C_Q0W] = qw
+    cst[_C_Q0X] = qx
+    cst[_C_Q0Y] = qy
+    cst[_C_Q0Z] = qz
+    return False
+
+
+# =============================================================================
+# per-(body, time) evaluation
+# =============================================================================
+def body_eval(cst, t):
+    """``(M_0, M_1, M_2, q_w, q_x, q_y, q_z)`` at time ``t``, input frame.
+
+    Scalar version of ``motion._generic_block`` plus the output mapping of
+    ``motion.exact_motion``; ``cst`` from :func:`body_setup`
+    (a non-equilibrium body).  The Jacobi functions at ``tau``, at
+    ``delta = lambda t`` (near branch) and, on the first call, at ``tau0``
+    are evaluated together.
+    """
+    p0 = int(cst[_C_PERM0])
+    p1 = int(cst[_C_PERM0 + 1])
+    p2 = int(cst[_C_PERM0 + 2])
+    s1 = cst[_C_SGN0 + 1]
+    if t == 0.0:
+        # the initial condition is reproduced exactly
+        Mk0 = cst[_C_M0S]
+        Mk1 = cst[_C_M0S + 1]
+        Mk2 = cst[_C_M0S + 2]
+        qw = 1.0
+        qk0 = 0.0
+        qk1 = 0.0
+        qk2 = 0.0
+    else:
+        ts = _ldexp(t, cst[_C_TSCALE], int(cst[_C_ESCALE]))
+        caseB = cst[_C_CASEB] != 0.0
+        dh, dl = _two_prod(cst[_C_LAM], ts)
+        th, tl = _dd_add(dh, dl, cst[_C_T0H], cst[_C_T0L])
+        near = abs(dh) <= cst[_C_KFULL]
+        first = cst[_C_HAVE_T0] == 0.0
+        if first:
+            k = 3 if near else 2
+            u2h, u2l, u3h, u3l = cst[_C_T0H], cst[_C_T0L], dh, dl
+        else:
+            k = 2 if near else 1
+            u2h, u2l, u3h, u3l = dh, dl, 0.0, 0.0
+        (
+            sn, cn, dn, n, r, s, c, d,
+            a2, b2, e2, f2, g2, h2, i2, j2,
+            a3, b3, e3, f3, g3, h3, i3, j3,
+        ) = _sncndn3(k, th, tl, u2h, u2l, u3h, u3l, cst)
+        if first:
+            # values at t = 0: sn(tau0), theta(tau0) and the reduced tau0
+            cst[_C_SN0] = a2
+            cst[_C_THETA0] = _theta(cst, f2, h2, i2)
+            kk = _C_TAU0V
+            cst[kk] = f2
+            cst[kk + 1] = g2
+            cst[kk + 2] = h2
+            cst[kk + 3] = i2
+            cst[kk + 4] = j2
+            cst[_C_HAVE_T0] = 1.0
+            snd, cnd, dnd, nd, rd, sd, cd, dd = a3, b3, e3, f3, g3, h3, i3, j3
+        else:
+            snd, cnd, dnd, nd, rd, sd, cd, dd = a2, b2, e2, f2, g2, h2, i2, j2
+        theta = _theta(cst, n, s, c)
+        if near:
+            dj = _near(cst, dh, dl, sn, snd, cnd, dnd, nd, rd, sd, cd, dd)
+        else:
+            dj = _far(cst, n, r, s, c, d)
+        sa = cst[_C_SA]
+        sc = cst[_C_SC]
+        Mc = sc * cst[_C_AC] * cn
+        M2 = sa * sc * cst[_C_A2] * sn
+        Ma = sa * cst[_C_AA] * dn
+        if caseB:
+            M1 = Mc
+            M3 = Ma
+        else:
+            M1 = Ma
+            M3 = Mc
+        psi = cst[_C_RATE] * ts + cst[_C_COEF] * dj
+        sigma = 1.0 if caseB else -1.0
+        alpha = psi - sigma * (theta - cst[_C_THETA0])
+        ca = math.cos(0.5 * alpha)
+        sal = math.sin(0.5 * alpha)
+        # q_e(alpha) with e = sa e_3 (B) or sa e_1 (A)
+        if caseB:
+            ex = 0.0
+            ez = sa * sal
+        else:
+            ex = sa * sal
+            ez = 0.0
+        tw, tx, ty, tz = _qmin(M1, M2, M3, caseB, sa)
+        uw, ux, uy, uz = _qmul(ca, ex, 0.0, ez, tw, tx, ty, tz)
+        qw, qx, qy, qz = _qmul(cst[_C_Q0W], -cst[_C_Q0X], -cst[_C_Q0Y], -cst[_C_Q0Z], uw, ux, uy, uz)
+        nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        qw = qw / nq
+        qk0 = qx / nq
+        qk1 = qy / nq
+        qk2 = qz / nq
+        fM = cst[_C_MSCALE]
+        eM = int(cst[_C_EM])
+        Mk0 = _ldexp(M1, fM, eM)
+        Mk1 = _ldexp(M2, fM, eM)
+        Mk2 = _ldexp(M3, fM, eM)
+    # back to the input frame: x[perm[k]] = sgn[k] x_sorted[k]
+    Ms = (1.0 * Mk0, s1 * Mk1, 1.0 * Mk2)
+    qs = (1.0 * qk0, s1 * qk1, 1.0 * qk2)
+    # inverse permutation: input axis a holds sorted axis k with perm[k] = a
+    i0 = 0 if p0 == 0 else (1 if p1 == 0 else 2)
+    i1 = 0 if p0 == 1 else (1 if p1 == 1 else 2)
+    i2 = 0 if p0 == 2 else (1 if p1 == 2 else 2)
+    return Ms[i0], Ms[i1], Ms[i2], qw, qs[i0], qs[i1], qs[i2]
+
+
+# =============================================================================
+# entry points
+# =============================================================================
+def motion_kernel(inertia, M0, t, Mout, qout):
+    """Fill ``Mout`` (nb, T, 3) and ``qout`` (nb, T, 4) for bodies (nb, 3) and times (T,).
+
+    Inputs are validated by the caller (finite, moments > 0, C-contiguous
+    float64).  O(1) memory per body.
+    """
+    nb = inertia.shape[0]
+    T = t.shape[0]
+    cst = np.zeros(N_CONST)
+    for b in range(nb):
+        i0 = inertia[b, 0]
+        i1 = inertia[b, 1]
+        i2 = inertia[b, 2]
+        m0 = M0[b, 0]
+        m1 = M0[b, 1]
+        m2 = M0[b, 2]
+        if body_setup(i0, i1, i2, m0, m1, m2, cst):
+            # relative equilibrium: M constant, uniform rotation about Omega = M0 / I
+            o0 = m0 / i0
+            o1 = m1 / i1
+            o2 = m2 / i2
+            w = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+            ws = w if w > 0.0 else 1.0
+            a0 = o0 / ws
+            a1 = o1 / ws
+            a2 = o2 / ws
+            hw = 0.5 * w
+            for j in range(T):
+                half = hw * t[j]
+                sh = math.sin(half)
+                Mout[b, j, 0] = m0
+                Mout[b, j, 1] = m1
+                Mout[b, j, 2] = m2
+                qout[b, j, 0] = math.cos(half)
+                qout[b, j, 1] = sh * a0
+                qout[b, j, 2] = sh * a1
+                qout[b, j, 3] = sh * a2
+        else:
+            for j in range(T):
+                r0, r1, r2, r3, r4, r5, r6 = body_eval(cst, t[j])
+                Mout[b, j, 0] = r0
+                Mout[b, j, 1] = r1
+                Mout[b, j, 2] = r2
+                qout[b, j, 0] = r3
+                qout[b, j, 1] = r4
+                qout[b, j, 2] = r5
+                qout[b, j, 3] = r6
+
+
+def constants_kernel(inertia, M0, out):
+    """Per-body ``(regime, m, m1, K, lam, tau0, period)`` into ``out`` (nb, 7)
+    (``motion.exact_constants``)."""
+    nb = inertia.shape[0]
+    cst = np.zeros(N_CONST)
+    for b in range(nb):
+        if body_setup(
+            inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], cst
+        ):
+            out[b, 0] = _EQUILIBRIUM
+            out[b, 1] = 0.0
+            out[b, 2] = 1.0
+            out[b, 3] = _HALF_PI
+            out[b, 4] = 0.0
+            out[b, 5] = 0.0
+            out[b, 6] = math.inf
+        else:
+            K = math.inf if cst[_C_SEP] != 0.0 else cst[_C_KH]
+            lam = math.ldexp(cst[_C_LAM], int(cst[_C_ESCALE]))
+            out[b, 0] = cst[_C_REGIME]
+            out[b, 1] = cst[_C_M]
+            out[b, 2] = cst[_C_M1]
+            out[b, 3] = K
+            out[b, 4] = lam
+            out[b, 5] = cst[_C_T0H] + cst[_C_T0L]
+            out[b, 6] = 4.0 * K / lam if lam > 0.0 else math.inf
+
+
+# =============================================================================
+# compilation
+# =============================================================================
+if USE_NUMBA:  # pragma: no branch
+    from llvmlite import ir as _ir
+    from numba import njit as _njit
+    from numba import types as _types
+    from numba.core.extending import intrinsic as _intrinsic
+
+    def _jit(f):
+        return _njit(cache=True, nogil=True, error_model="numpy")(f)
+
+    @_intrinsic
+    def _fma(typingctx, a, b, c):
+        """``a * b + c`` rounded once (LLVM ``llvm.fma.f64``)."""
+        sig = _types.float64(_types.float64, _types.float64, _types.float64)
+
+        def codegen(context, builder, signature, args):
+            d = _ir.DoubleType()
+            fn = builder.module.declare_intrinsic("llvm.fma", [d], _ir.FunctionType(d, [d, d, d]))
+            return builder.call(fn, args)
+
+        return sig, codegen
+
+    def _two_prod_f(a, b):  # noqa: F811 - the compiled version uses the FMA
+        p = a * b
+        return p, _fma(a, b, -p)
+
+    _two_sum = _jit(_two_sum)
+    _quick_two_sum = _jit(_quick_two_sum)
+    _split = _jit(_split)
+    _two_prod = _jit(_two_prod)
+    _dd_add = _jit(_dd_add)
+    _dd_mul = _jit(_dd_mul)
+    _two_prod_f = _jit(_two_prod_f)
+    _dd_mul_f = _jit(_dd_mul_f)
+    _dd_mul_d_f = _jit(_dd_mul_d_f)
+    _dd_div_f = _jit(_dd_div_f)
+    _dd_sqrt_f = _jit(_dd_sqrt_f)
+    _pow2 = _jit(_pow2)
+    _ldexp = _jit(_ldexp)
+    _rf_poly = _jit(_rf_poly)
+    _rc1 = _jit(_rc1)
+    _rj_init = _jit(_rj_init)
+    _rj_step = _jit(_rj_step)
+    _rj_finish = _jit(_rj_finish)
+    _rj3 = _jit(_rj3)
+    _params = _jit(_params)
+    _sech = _jit(_sech)
+    _reduce = _jit(_reduce)
+    _real_start = _jit(_real_start)
+    _real_level = _jit(_real_level)
+    _imag_start = _jit(_imag_start)
+    _imag_level = _jit(_imag_level)
+    _finish = _jit(_finish)
+    _sncndn3 = _jit(_sncndn3)
+    _jtot_args = _jit(_jtot_args)
+    _jtot_from = _jit(_jtot_from)
+    _jtot = _jit(_jtot)
+    _get_jc = _jit(_get_jc)
+    _get_jcd = _jit(_get_jcd)
+    _theta = _jit(_theta)
+    _jsep = _jit(_jsep)
+    _near = _jit(_near)
+    _far = _jit(_far)
+    _qmin = _jit(_qmin)
+    _qmul = _jit(_qmul)
+    body_setup = _jit(body_setup)
+    body_eval = _jit(body_eval)
+    motion_kernel = _jit(motion_kernel)
+    constants_kernel = _jit(constants_kernel)

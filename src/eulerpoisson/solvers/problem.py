@@ -1,0 +1,136 @@
+r"""The initial value problem every solution method receives: :class:`Problem`.
+
+:func:`make_problem` validates and broadcasts the arguments of
+:func:`~eulerpoisson.solve` into one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..attitude.core import Attitude, as_quaternion
+from ..errors import InvalidInputError
+from ..model.body import RigidBody
+from ..numerics.quaternion import qmul
+from ..util.validate import as_float_array
+
+__all__ = ["Problem", "make_problem", "compose_initial"]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """A batch of free-rigid-body initial value problems.
+
+    Attributes
+    ----------
+    body : RigidBody
+        Bodies, batch shape broadcastable to ``batch_shape``.
+    q0 : ndarray, shape (*batch_shape, 4)
+        Initial attitudes (unit quaternions, scalar first).
+    omega0 : ndarray, shape (*batch_shape, 3)
+        Initial body angular velocities, in the body frame of ``body.inertia``.
+    t : ndarray, shape (T,)
+        Output times, any order, negative allowed.
+    """
+
+    body: RigidBody
+    q0: np.ndarray
+    omega0: np.ndarray
+    t: np.ndarray
+
+    @property
+    def batch_shape(self) -> tuple[int, ...]:
+        return self.q0.shape[:-1]
+
+    @property
+    def inertia(self) -> np.ndarray:
+        """Inertia tensors broadcast to the batch, (*batch_shape, 3, 3)."""
+        return np.broadcast_to(self.body.inertia, self.batch_shape + (3, 3))
+
+    @property
+    def principal_moments(self) -> np.ndarray:
+        return np.broadcast_to(self.body.principal_moments, self.batch_shape + (3,))
+
+    @property
+    def principal_axes(self) -> np.ndarray:
+        return np.broadcast_to(self.body.principal_axes, self.batch_shape + (3, 3))
+
+    @property
+    def M0(self) -> np.ndarray:
+        """Initial body angular momentum, (*batch_shape, 3)."""
+        return np.einsum("...ij,...j->...i", self.inertia, self.omega0)
+
+
+def _as_body(body) -> RigidBody:
+    if isinstance(body, RigidBody):
+        return body
+    if isinstance(body, (str, bytes)) or body is None:
+        raise TypeError(f"body must be a RigidBody or an inertia array, got {body!r}")
+    return RigidBody(body)
+
+
+def _as_times(t) -> np.ndarray:
+    ta = as_float_array(t, "t")
+    if ta.ndim > 1:
+        raise InvalidInputError(f"t must be a scalar or a 1-D array of output times, got shape {ta.shape}")
+    return np.atleast_1d(ta)
+
+
+def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
+    """Validate and broadcast the arguments of :func:`solve` into a :class:`Problem`.
+
+    Raises
+    ------
+    TypeError, InvalidInputError
+        See :func:`solve`.
+    """
+    body = _as_body(body)
+    times = _as_times(t)
+    if (omega0 is None) == (m0 is None):
+        raise TypeError("give exactly one of omega0 (body angular velocity) or m0 (spatial angular momentum)")
+    if attitude0 is None:
+        q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    elif isinstance(attitude0, Attitude):
+        q0 = attitude0.as_quaternion()
+    else:
+        q0 = as_float_array(attitude0, "attitude0", (4,))
+        nrm = np.linalg.norm(q0, axis=-1)
+        if np.any(np.abs(nrm - 1.0) > 1e-8):
+            raise InvalidInputError(
+                f"attitude0 must be a unit quaternion (w, x, y, z); its norm is {float(nrm.ravel()[np.argmax(np.abs(nrm.ravel() - 1.0))]):.9g}"
+            )
+        q0 = as_quaternion(q0, "attitude0")
+    name, v0 = ("omega0", omega0) if omega0 is not None else ("m0", m0)
+    v0 = as_float_array(v0, name, (3,))
+    try:
+        shape = np.broadcast_shapes(q0.shape[:-1], v0.shape[:-1], body.batch_shape)
+    except ValueError:
+        raise InvalidInputError(
+            f"the batch shapes do not broadcast: body {body.batch_shape} (inertia {body.inertia.shape}), "
+            f"{name} {v0.shape[:-1]} (array {v0.shape}), attitude0 {q0.shape[:-1]} (array {q0.shape}); "
+            f"leading axes must broadcast as in numpy"
+        ) from None
+    if omega0 is not None:
+        w0 = v0
+    else:
+        R0 = Attitude(q0).as_matrix()
+        M = np.einsum("...ji,...j->...i", R0, v0)
+        w0 = np.einsum("...ij,...j->...i", body.inertia_inv, M)
+    q0 = np.broadcast_to(q0, shape + (4,)).copy()
+    w0 = np.broadcast_to(w0, shape + (3,)).copy()
+    return Problem(body=body, q0=q0, omega0=w0, t=times)
+
+
+def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
+    r"""Attitudes :math:`q_0\otimes q_\mathrm{rel}(t)` for relative motions starting at the identity.
+
+    ``q_rel`` has shape (*batch_shape, T, 4); left invariance of the free body
+    makes this the motion from ``q0``. When every ``q0`` is the identity,
+    ``q_rel`` is returned as it is (the product would only copy it).
+    """
+    q0 = problem.q0
+    if np.all(q0[..., 0] == 1.0) and not np.any(q0[..., 1:]):
+        return q_rel
+    return qmul(q0[..., None, :], q_rel)

@@ -1,0 +1,141 @@
+"""Input validation shared by the package (private)."""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+from ..errors import InvalidInputError
+
+
+def describe_value(x) -> str:
+    a = np.asarray(x)
+    if a.size <= 6:
+        return repr(a.tolist()) if a.ndim else repr(a.item())
+    return f"array of shape {a.shape}"
+
+
+def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite: bool = False) -> np.ndarray:
+    """Return ``x`` as a float64 array whose trailing shape is ``tail``.
+
+    Parameters
+    ----------
+    x : array_like
+        The value to convert.
+    name : str
+        Argument name used in error messages.
+    tail : tuple of int
+        Required trailing dimensions, e.g. ``(3,)`` or ``(3, 3)``.
+    allow_nonfinite : bool
+        Accept NaN and inf (default: reject them).
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not numeric (strings, objects, complex numbers).
+    InvalidInputError
+        If the trailing shape is wrong or a value is NaN or infinite.
+    """
+    if isinstance(x, (str, bytes)):
+        raise TypeError(f"{name} must be numeric, got the string {x!r}")
+    try:
+        a = np.asarray(x)
+    except Exception as exc:  # ragged lists etc.
+        raise InvalidInputError(f"{name} could not be converted to an array: {exc}") from exc
+    if a.dtype == object or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
+        raise TypeError(f"{name} must be a real numeric array, got dtype {a.dtype}")
+    if np.iscomplexobj(a):
+        raise TypeError(f"{name} must be real, got complex dtype {a.dtype}")
+    a = a.astype(np.float64, copy=False)
+    nt = len(tail)
+    if nt and (a.ndim < nt or a.shape[a.ndim - nt:] != tuple(tail)):
+        want = "(..., " + ", ".join(str(t) for t in tail) + ")"
+        raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
+    if not allow_nonfinite and not np.all(np.isfinite(a)):
+        raise InvalidInputError(f"{name} contains NaN or infinite values: {describe_value(a)}")
+    return a
+
+
+def as_scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, integer: bool = False) -> float:
+    """Return ``x`` as a finite Python float (or int), with range checks.
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not a real number.
+    InvalidInputError
+        If ``x`` is not finite or out of range.
+    """
+    if isinstance(x, bool) or not isinstance(x, (numbers.Real, np.floating, np.integer)):
+        if isinstance(x, np.ndarray) and x.ndim == 0:
+            x = x.item()
+        else:
+            raise TypeError(f"{name} must be a real number, got {type(x).__name__} {x!r}")
+    v = float(x)
+    if not np.isfinite(v):
+        raise InvalidInputError(f"{name} must be finite, got {v!r}")
+    if integer:
+        if v != int(v):
+            raise InvalidInputError(f"{name} must be an integer, got {x!r}")
+        v = int(v)
+    if positive and not v > 0:
+        raise InvalidInputError(f"{name} must be > 0, got {x!r}")
+    if nonnegative and not v >= 0:
+        raise InvalidInputError(f"{name} must be >= 0, got {x!r}")
+    return v
+
+
+def as_bool(x, name: str) -> bool:
+    """A flag: ``bool`` or ``numpy.bool_`` only (a string such as ``"no"`` is truthy, so it is refused).
+
+    Raises
+    ------
+    TypeError
+        If ``x`` is not a boolean.
+    """
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    raise TypeError(f"{name} must be True or False, got {x!r} ({type(x).__name__})")
+
+
+def check_broadcast(**arrays) -> tuple[int, ...]:
+    """Broadcast batch shape of arrays whose last axis is a vector (quaternion, Gibbs vector...).
+
+    ``check_broadcast(p=p, q=q)`` returns ``np.broadcast_shapes(p.shape[:-1], q.shape[:-1])``.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming every argument with its shape when the batch shapes do not broadcast.
+    """
+    try:
+        return np.broadcast_shapes(*(np.shape(a)[:-1] for a in arrays.values()))
+    except ValueError:
+        desc = ", ".join(f"{k} {np.shape(a)}" for k, a in arrays.items())
+        raise InvalidInputError(
+            f"batch shapes do not broadcast: {desc} (leading axes must broadcast as in numpy)"
+        ) from None
+
+
+def as_shape(shape, name: str = "shape") -> tuple[int, ...]:
+    """A batch shape: a non-negative int or a sequence of them (not bools, not floats).
+
+    Raises
+    ------
+    TypeError
+        If ``shape`` is not an int or a sequence of ints.
+    InvalidInputError
+        If an entry is negative.
+    """
+    items = (shape,) if isinstance(shape, (int, np.integer)) and not isinstance(shape, (bool, np.bool_)) else shape
+    try:
+        items = tuple(items)
+    except TypeError:
+        raise TypeError(f"{name} must be an int or a tuple of ints, got {shape!r}") from None
+    for k in items:
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise TypeError(f"{name} must be an int or a tuple of ints, got {shape!r}")
+        if k < 0:
+            raise InvalidInputError(f"{name} entries must be >= 0, got {shape!r}")
+    return tuple(int(k) for k in items)

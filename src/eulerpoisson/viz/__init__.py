@@ -1,0 +1,1 @@
+"""Pictures and animations of trajectories (matplotlib, the ``plot`` extra)."""

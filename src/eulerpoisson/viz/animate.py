@@ -1,0 +1,771 @@
+r"""Animations of a tumbling body: a self-contained HTML page, a GIF or an MP4.
+
+:func:`animate` shows the body as a uniform box with the proportions of its
+inertia ellipsoid (:func:`box_dimensions`), turning according to the
+trajectory, together with its spatial angular momentum :math:`\mathbf m`,
+which is fixed in space for the free body.
+
+* ``.html`` — one self-contained page (inline JavaScript, no network, no
+  library): the sampled attitude quaternions are embedded as JSON and
+  interpolated by spherical linear interpolation (slerp); the box is painted
+  on a ``<canvas>`` with a small hand-written perspective projection
+  (back-face culling, painter's algorithm, Lambert-shaded faces). The page
+  has a play/pause button, a time slider, and drag-to-rotate for the view.
+* ``.gif`` — rendered with matplotlib's ``PillowWriter`` (Pillow is a
+  dependency of matplotlib).
+* ``.mp4`` — rendered with matplotlib's ``FFMpegWriter``; needs the
+  ``ffmpeg`` program.
+
+The face colours are those of :data:`eulerpoisson.viz.plots.AXIS_COLORS`: the
+two faces normal to principal axis :math:`i` have the colour of axis
+:math:`i` (the face on the negative side lighter), so a flip of the
+intermediate axis — the tennis racket — is easy to see.
+
+Files are written atomically (temporary file, then rename).
+
+References
+----------
+K. Shoemake, "Animating rotation with quaternion curves", SIGGRAPH 1985
+(slerp). L. D. Landau and E. M. Lifshitz, *Mechanics*, §32 (moments of
+inertia of a box).
+"""
+
+from __future__ import annotations
+
+import html as _html
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+
+from ..io.atomic import atomic_path
+from ..util.validate import as_float_array
+from ..errors import InvalidInputError, MissingDependencyError
+from .plots import AXIS_COLORS, import_matplotlib, select_body
+
+__all__ = ["animate", "box_dimensions", "slerp_series", "FORMATS"]
+
+#: output formats of :func:`animate`, by file extension
+FORMATS = ("html", "gif", "mp4")
+
+#: thinnest side of the box relative to the longest (a planar body, I1 + I2 = I3, has zero thickness)
+MIN_THICKNESS = 0.04
+
+#: most attitude samples embedded in an HTML page (longer trajectories are subsampled)
+MAX_HTML_SAMPLES = 20000
+
+_ELEVATION = 22.0  # camera elevation, degrees
+_M_AZIMUTH = 70.0  # m is shown this far (degrees) in azimuth from the viewing direction
+
+
+def _view(mdir) -> tuple[float, float]:
+    """Camera (azimuth, elevation) in degrees: m seen from the side, pointing right and a little towards the viewer."""
+    if mdir is None or np.hypot(mdir[0], mdir[1]) < 1e-3:
+        return (-55.0, _ELEVATION)
+    return (float(np.degrees(np.arctan2(mdir[1], mdir[0])) - _M_AZIMUTH), _ELEVATION)
+
+
+def _camera(view) -> np.ndarray:
+    """Rows: screen right, screen up, towards the viewer (space frame), for (azimuth, elevation) in degrees."""
+    az, el = np.radians(view[0]), np.radians(view[1])
+    ca, sa, ce, se = np.cos(az), np.sin(az), np.cos(el), np.sin(el)
+    return np.array([[-sa, ca, 0.0], [-se * ca, -se * sa, ce], [ce * ca, ce * sa, se]])
+
+
+def hidden_by_box(points, R, half, axes, eye, *, orthographic=False) -> np.ndarray:
+    r"""Which points are inside the box or behind it as seen from ``eye``.
+
+    The box has half sides ``half`` along the principal axes (columns of
+    ``axes``, body frame) and attitude ``R`` (space = R body). A point
+    :math:`\mathbf p` is hidden when the segment from the eye to it meets the
+    box (slab test). With ``orthographic=True``, ``eye`` is the direction
+    towards the viewer and the segment runs from :math:`\mathbf p` to
+    infinity along it.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 3)
+        Space frame.
+    R : ndarray, shape (3, 3)
+    half : ndarray, shape (3,)
+    axes : ndarray, shape (3, 3)
+    eye : ndarray, shape (3,)
+
+    Returns
+    -------
+    ndarray of bool, shape (N,)
+    """
+    B = R @ np.asarray(axes)  # principal axes in space
+    p = np.asarray(points, float) @ B  # principal box coordinates
+    e = np.asarray(eye, float) @ B
+    if orthographic:
+        a, d = p, np.broadcast_to(e, p.shape)  # ray p + s d, s in [0, inf)
+        lo_s, hi_s = 0.0, np.inf
+    else:
+        a, d = np.broadcast_to(e, p.shape), p - e  # eye + s (p - eye), s in [0, 1]
+        lo_s, hi_s = 0.0, 1.0
+    h = np.asarray(half, float) * (1.0 - 1e-9)
+    t0 = np.full(p.shape[0], lo_s)
+    t1 = np.full(p.shape[0], hi_s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for i in range(3):
+            par = np.abs(d[:, i]) < 1e-300
+            u = (-h[i] - a[:, i]) / d[:, i]
+            v = (h[i] - a[:, i]) / d[:, i]
+            lo = np.where(par, np.where(np.abs(a[:, i]) <= h[i], -np.inf, np.inf), np.minimum(u, v))
+            hi = np.where(par, np.where(np.abs(a[:, i]) <= h[i], np.inf, -np.inf), np.maximum(u, v))
+            t0 = np.maximum(t0, lo)
+            t1 = np.minimum(t1, hi)
+    return t0 <= t1
+
+
+# ---------------------------------------------------------------------------
+# geometry
+# ---------------------------------------------------------------------------
+def box_dimensions(moments, *, min_thickness: float = MIN_THICKNESS) -> np.ndarray:
+    r"""Side lengths of the uniform box with the given principal moments, scaled to a longest side of 1.
+
+    A uniform box of mass :math:`m` and sides :math:`a_1, a_2, a_3` has
+    :math:`I_1 = m(a_2^2+a_3^2)/12` and cyclic, so
+    :math:`a_1^2+a_2^2+a_3^2 = 6(I_1+I_2+I_3)/m` and
+
+    .. math:: a_i^2 = \frac{6}{m}\,(I_j + I_k - I_i),
+
+    real by the triangle inequality of a physical body.
+
+    Parameters
+    ----------
+    moments : array_like, shape (3,)
+        Principal moments :math:`I_i > 0`.
+    min_thickness : float
+        Sides shorter than this fraction of the longest are raised to it (a
+        planar body would otherwise be invisible edge-on).
+
+    Returns
+    -------
+    ndarray, shape (3,)
+        :math:`a_i/\max_j a_j`.
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shape, non-positive or non-finite moments, or moments violating
+        the triangle inequality :math:`I_i \le I_j + I_k`.
+    """
+    I = as_float_array(moments, "moments")
+    if I.shape != (3,):
+        raise InvalidInputError(f"moments must have shape (3,), got {I.shape}")
+    if np.any(I <= 0):
+        raise InvalidInputError(f"moments must be > 0, got {I.tolist()}")
+    sq = I.sum() - 2.0 * I  # I_j + I_k - I_i
+    tol = 1e-12 * I.sum()
+    if np.any(sq < -tol):
+        raise InvalidInputError(
+            f"moments {I.tolist()} violate the triangle inequality I_i <= I_j + I_k; no box has them"
+        )
+    a = np.sqrt(np.clip(sq, 0.0, None))
+    a = a / a.max()
+    return np.maximum(a, float(min_thickness))
+
+
+def _box_mesh(moments, axes):
+    """Vertices (8, 3) in the body frame and faces (vertex indices, body normal, axis, sign)."""
+    sides = box_dimensions(moments)
+    half = 0.5 * sides
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
+    verts = (corners * half) @ np.asarray(axes).T  # principal -> body frame
+    faces = []
+    for i in range(3):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        for s in (1, -1):
+            cyc = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+            if s < 0:
+                cyc = cyc[::-1]
+            idx = []
+            for uj, uk in cyc:
+                c = np.zeros(3)
+                c[i], c[j], c[k] = s, uj, uk
+                idx.append(int(np.flatnonzero(np.all(corners == c, axis=1))[0]))
+            normal = s * np.asarray(axes)[:, i]
+            faces.append((idx, normal, i, s))
+    return sides, verts, faces
+
+
+def _face_rgb(axis: int, sign: int) -> list[int]:
+    h = AXIS_COLORS[axis].lstrip("#")
+    rgb = np.array([int(h[p:p + 2], 16) for p in (0, 2, 4)], float)
+    if sign < 0:  # the face on the negative side: lighter
+        rgb = rgb + 0.45 * (255.0 - rgb)
+    return [int(round(c)) for c in rgb]
+
+
+def slerp_series(t, q, tf) -> np.ndarray:
+    r"""Attitudes at times ``tf`` by spherical linear interpolation of the samples ``(t, q)``.
+
+    .. math:: q(s) = \frac{\sin((1-s)\theta)}{\sin\theta}q_i + \frac{\sin(s\theta)}{\sin\theta}q_{i+1},
+              \qquad \cos\theta = |q_i\cdot q_{i+1}|,
+
+    with the sign of :math:`q_{i+1}` chosen so that :math:`q_i\cdot q_{i+1}\ge 0`
+    (the shorter arc). Exact for a rotation with constant angular velocity
+    between samples. Times outside ``[t[0], t[-1]]`` are clamped.
+
+    Parameters
+    ----------
+    t : array_like, shape (T,)
+        Sample times, non-decreasing, T >= 1.
+    q : array_like, shape (T, 4)
+        Unit quaternions.
+    tf : array_like, shape (F,)
+        Requested times.
+
+    Returns
+    -------
+    ndarray, shape (F, 4)
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shapes, non-finite values, decreasing ``t``.
+    """
+    t = as_float_array(t, "t")
+    q = as_float_array(q, "q", (4,))
+    tf = np.atleast_1d(as_float_array(tf, "tf"))
+    if t.ndim != 1 or q.shape != (t.size, 4) or t.size < 1:
+        raise InvalidInputError(f"t must have shape (T,) and q (T, 4) with T >= 1; got {t.shape} and {q.shape}")
+    if np.any(np.diff(t) < 0):
+        raise InvalidInputError("t must be non-decreasing")
+    if t.size == 1:
+        return np.broadcast_to(q[0] / np.linalg.norm(q[0]), tf.shape + (4,)).copy()
+    tc = np.clip(tf, t[0], t[-1])
+    i = np.clip(np.searchsorted(t, tc, side="right") - 1, 0, t.size - 2)
+    dt = t[i + 1] - t[i]
+    s = np.where(dt > 0, (tc - t[i]) / np.where(dt > 0, dt, 1.0), 0.0)
+    a, b = q[i], q[i + 1]
+    d = np.sum(a * b, -1)
+    b = np.where(d[:, None] < 0, -b, b)
+    d = np.abs(d)
+    th = np.arccos(np.clip(d, -1.0, 1.0))
+    st = np.sin(th)
+    small = st < 1e-6
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k0 = np.where(small, 1.0 - s, np.sin((1.0 - s) * th) / np.where(small, 1.0, st))
+        k1 = np.where(small, s, np.sin(s * th) / np.where(small, 1.0, st))
+    r = k0[:, None] * a + k1[:, None] * b
+    return r / np.linalg.norm(r, axis=-1, keepdims=True)
+
+
+# ---------------------------------------------------------------------------
+# argument checks
+# ---------------------------------------------------------------------------
+def _check_args(out, fps, duration, size):
+    if not isinstance(out, (str, os.PathLike)):
+        raise TypeError(f"out must be a file name (str or path), got {type(out).__name__}")
+    p = Path(out)
+    ext = p.suffix.lower().lstrip(".")
+    if ext == "htm":
+        ext = "html"
+    if ext not in FORMATS:
+        raise InvalidInputError(
+            f"out={str(out)!r}: unsupported file extension {p.suffix!r}; use .html (self-contained page), "
+            ".gif or .mp4"
+        )
+    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) or not (
+        np.isfinite(fps) and fps > 0
+    ):
+        raise InvalidInputError(f"fps must be a positive number of frames per second, got {fps!r}")
+    if duration is not None and (
+        isinstance(duration, bool)
+        or not isinstance(duration, (int, float, np.integer, np.floating))
+        or not (np.isfinite(duration) and duration > 0)
+    ):
+        raise InvalidInputError(f"duration must be None or a positive number of seconds, got {duration!r}")
+    try:
+        w, h = (int(v) for v in size)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"size must be (width, height) in pixels, got {size!r}") from None
+    if not (16 <= w <= 4096 and 16 <= h <= 4096):
+        raise InvalidInputError(f"size must be (width, height) between 16 and 4096 pixels, got {size!r}")
+    return p, ext, (w, h)
+
+
+def default_duration(span: float) -> float:
+    return float(np.clip(span, 2.0, 20.0))
+
+
+# ---------------------------------------------------------------------------
+# public entry point
+# ---------------------------------------------------------------------------
+def animate(traj, out, *, fps=30, duration=None, index=0, size=(640, 480),
+            max_samples: int = MAX_HTML_SAMPLES) -> Path:
+    r"""Write an animation of the tumbling body: ``.html``, ``.gif`` or ``.mp4`` by the extension of ``out``.
+
+    Parameters
+    ----------
+    traj : Trajectory
+        The motion (for a batch, the body ``index`` is shown).
+    out : str or path
+        Output file; ``.html`` (a self-contained page), ``.gif`` or ``.mp4``.
+    fps : float
+        Frames per second of a GIF/MP4 (the HTML page animates at the
+        browser's frame rate).
+    duration : float, optional
+        Playing time of the whole trajectory in seconds (the HTML page
+        loops). Default: the trajectory's time span, clipped to [2, 20] s.
+        A GIF/MP4 has ``round(fps * duration)`` frames (at least 2).
+    index : int or tuple
+        Body of a batched trajectory.
+    size : (int, int)
+        Width and height in pixels of the canvas / video frames.
+    max_samples : int
+        Most attitude samples embedded in an HTML page; longer trajectories
+        are subsampled evenly (keeping both ends).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+
+    Raises
+    ------
+    InvalidInputError
+        Unsupported extension, non-positive ``fps`` or ``duration``, bad
+        ``size`` or ``index``, fewer than two distinct times.
+    TypeError
+        ``traj`` is not a Trajectory, ``out`` not a path.
+    MissingDependencyError
+        matplotlib is missing (GIF/MP4, extra ``plot``), or ``ffmpeg`` is not
+        installed (MP4).
+
+    Examples
+    --------
+    >>> tr = ep.solve([3, 5, 7], np.linspace(0, 150, 3001), omega0=[0, 0.4, 0.01 / 7])  # doctest: +SKIP
+    >>> animate(tr, "racket.html")                                                   # doctest: +SKIP
+    """
+    one = select_body(traj, index)
+    p, ext, px = _check_args(out, fps, duration, size)
+    span = float(one.t[-1] - one.t[0])
+    dur = default_duration(span) if duration is None else float(duration)
+    sides, verts, faces = _box_mesh(one.moments, one.axes)
+    m0 = one.m[one.first]
+    mn = float(np.linalg.norm(m0))
+    mdir = m0 / mn if mn > 0 else None
+    if ext == "html":
+        text = _html_page(one, sides, verts, faces, mdir, dur, px, int(max_samples))
+        with atomic_path(p, suffix=".html") as tmp:
+            with open(tmp, "w", encoding="utf-8") as fh:
+                fh.write(text)
+        return p
+    nframes = max(2, int(round(float(fps) * dur)))
+    tf = np.linspace(one.t[0], one.t[-1], nframes)
+    qf = slerp_series(one.t, one.q, tf)
+    _render_video(one, sides, verts, faces, mdir, tf, qf, p, ext, float(fps), px)
+    return p
+
+
+# ---------------------------------------------------------------------------
+# HTML
+# ---------------------------------------------------------------------------
+def _html_page(one, sides, verts, faces, mdir, duration, px, max_samples) -> str:
+    T = len(one.t)
+    if max_samples < 2:
+        raise InvalidInputError(f"max_samples must be >= 2, got {max_samples}")
+    if T > max_samples:
+        sel = np.unique(np.round(np.linspace(0, T - 1, max_samples)).astype(int))
+    else:
+        sel = np.arange(T)
+    t = one.t[sel]
+    q = one.q[sel]
+    title = f"{one.label} — method: {one.method}"
+    data = {
+        "title": title,
+        "unit": one.time_unit,
+        "t": [float(f"{v:.10g}") for v in t],
+        "q": np.round(q, 7).tolist(),
+        "verts": np.round(verts, 6).tolist(),
+        "faces": [
+            {"v": idx, "normal": np.round(nrm, 9).tolist(), "color": _face_rgb(ax, s), "axis": ax + 1}
+            for idx, nrm, ax, s in faces
+        ],
+        "m": None if mdir is None else np.round(mdir, 9).tolist(),
+        "moments": [float(v) for v in one.moments],
+        "duration": float(duration),
+        "view": list(_view(mdir)),
+        "half": np.round(0.5 * sides, 9).tolist(),
+        "axes": np.round(np.asarray(one.axes).T, 12).tolist(),
+        "axisColors": list(AXIS_COLORS),
+    }
+    blob = json.dumps(data, separators=(",", ":"), ensure_ascii=True)
+    blob = blob.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
+    w, h = px
+    moms = ", ".join(f"I{i + 1} = {v:.4g}" for i, v in enumerate(one.moments))
+    page = _TEMPLATE
+    for key, val in (
+        ("__TITLE__", _html.escape(title)),
+        ("__MOMENTS__", _html.escape(moms)),
+        ("__W__", str(w)),
+        ("__H__", str(h)),
+        ("__DATA__", blob),
+    ):
+        page = page.replace(key, val)
+    return page
+
+
+_TEMPLATE = r"""<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<meta name="generator" content="eulerpoisson.viz.animate">
+<title>Tumbling body: __TITLE__</title>
+<style>
+  body { font-family: system-ui, -apple-system, "Segoe UI", Helvetica, Arial, sans-serif;
+         margin: 0; padding: 10px 0; background: #eef0f3; color: #222; }
+  main { width: __W__px; margin: 0 auto; }
+  h1 { font-size: 15px; font-weight: 600; margin: 0 0 6px 0; white-space: nowrap;
+       overflow: hidden; text-overflow: ellipsis; }
+  #ep-canvas { display: block; background: #ffffff; border: 1px solid #c8ccd2; border-radius: 4px;
+               cursor: grab; touch-action: none; }
+  .ctl { display: flex; align-items: center; gap: 10px; margin-top: 6px; font-size: 13px; }
+  #ep-slider { flex: 1; }
+  #ep-time { font-variant-numeric: tabular-nums; min-width: 150px; text-align: right; }
+  button { font-size: 13px; padding: 2px 12px; min-width: 64px; }
+  .legend { font-size: 12px; color: #555; margin-top: 4px; }
+  .sw { display: inline-block; width: 10px; height: 10px; margin: 0 3px 0 8px; vertical-align: -1px; }
+</style>
+</head>
+<body>
+<main>
+<h1>__TITLE__</h1>
+<noscript><p><strong>This animation needs JavaScript.</strong> It shows a box with the
+proportions of the body's inertia ellipsoid (__MOMENTS__) tumbling freely, with its angular
+momentum m fixed in space. Enable JavaScript, or write a GIF with
+<code>eulerpoisson.viz.animate.animate(traj, "out.gif")</code>.</p></noscript>
+<canvas id="ep-canvas" width="__W__" height="__H__" aria-label="tumbling rigid body"></canvas>
+<div class="ctl">
+  <button id="ep-play" type="button">Pause</button>
+  <input id="ep-slider" type="range" min="0" max="1000" step="1" value="0" aria-label="time">
+  <span id="ep-time"></span>
+</div>
+<div class="legend">Box with the proportions of the inertia ellipsoid (__MOMENTS__); faces coloured by principal
+axis<span class="sw" style="background:#d62728"></span>1<span class="sw" style="background:#2ca02c"></span>2<span
+class="sw" style="background:#1f77b4"></span>3 (lighter: negative side). Black arrow: angular momentum m, fixed in
+space. Drag to turn the view.</div>
+</main>
+<script type="application/json" id="ep-data">__DATA__</script>
+<script>
+(function () {
+  "use strict";
+  var D = JSON.parse(document.getElementById("ep-data").textContent);
+  var cv = document.getElementById("ep-canvas");
+  var ctx = cv.getContext("2d");
+  var W = cv.width, H = cv.height;
+  var dpr = window.devicePixelRatio || 1;
+  cv.style.width = W + "px"; cv.style.height = H + "px";
+  cv.width = Math.round(W * dpr); cv.height = Math.round(H * dpr);
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+
+  var T = D.t, Q = D.q, n = T.length, t0 = T[0], t1 = T[n - 1];
+  var span = t1 - t0, speed = span / D.duration;
+  var az = D.view[0] * Math.PI / 180, el = D.view[1] * Math.PI / 180;
+  var playing = true, tcur = t0, last = null;
+
+  // scene size: box half-diagonal and the arrow
+  var R0 = 0;
+  D.verts.forEach(function (v) { R0 = Math.max(R0, Math.hypot(v[0], v[1], v[2])); });
+  var ARROW = 1.6 * R0, RS = Math.max(ARROW, 1.2 * R0);
+  var DIST = 5 * RS, SCALE = 0.40 * Math.min(W, H) / RS;
+  var LIGHT = norm([0.25, 0.6, 0.75]);
+
+  function norm(v) { var s = Math.hypot(v[0], v[1], v[2]); return [v[0] / s, v[1] / s, v[2] / s]; }
+  function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+  // rotate v by the unit quaternion q = (w, x, y, z): v + w t + u x t with t = 2 u x v
+  function qrot(q, v) {
+    var w = q[0], x = q[1], y = q[2], z = q[3];
+    var tx = 2 * (y * v[2] - z * v[1]), ty = 2 * (z * v[0] - x * v[2]), tz = 2 * (x * v[1] - y * v[0]);
+    return [v[0] + w * tx + (y * tz - z * ty), v[1] + w * ty + (z * tx - x * tz), v[2] + w * tz + (x * ty - y * tx)];
+  }
+
+  // spherical linear interpolation between unit quaternions (shorter arc)
+  function slerp(a, b, s) {
+    var d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], sg = 1;
+    if (d < 0) { d = -d; sg = -1; }
+    var k0, k1;
+    if (d > 0.9999995) { k0 = 1 - s; k1 = s; }
+    else { var th = Math.acos(d), st = Math.sin(th); k0 = Math.sin((1 - s) * th) / st; k1 = Math.sin(s * th) / st; }
+    k1 *= sg;
+    var r = [k0 * a[0] + k1 * b[0], k0 * a[1] + k1 * b[1], k0 * a[2] + k1 * b[2], k0 * a[3] + k1 * b[3]];
+    var s2 = Math.hypot(r[0], r[1], r[2], r[3]);
+    return [r[0] / s2, r[1] / s2, r[2] / s2, r[3] / s2];
+  }
+
+  function attitude(tt) {
+    if (n === 1 || tt <= t0) return Q[0];
+    if (tt >= t1) return Q[n - 1];
+    var lo = 0, hi = n - 1;
+    while (hi - lo > 1) { var mid = (lo + hi) >> 1; if (T[mid] <= tt) lo = mid; else hi = mid; }
+    var dt = T[hi] - T[lo];
+    return slerp(Q[lo], Q[hi], dt > 0 ? (tt - T[lo]) / dt : 0);
+  }
+
+  // camera: space (x, y, z) -> (right, up, towards the viewer)
+  function cam(p) {
+    var ca = Math.cos(az), sa = Math.sin(az), ce = Math.cos(el), se = Math.sin(el);
+    return [-sa * p[0] + ca * p[1],
+            -se * ca * p[0] - se * sa * p[1] + ce * p[2],
+             ce * ca * p[0] + ce * sa * p[1] + se * p[2]];
+  }
+  function proj(c) { var f = DIST / (DIST - c[2]); return [W / 2 + SCALE * c[0] * f, H / 2 - SCALE * c[1] * f]; }
+
+  function rgb(c, k) {
+    return "rgb(" + Math.round(c[0] * k) + "," + Math.round(c[1] * k) + "," + Math.round(c[2] * k) + ")";
+  }
+
+  // space point -> coordinates along the box's principal axes
+  function toBox(q, p) {
+    var b = qrot([q[0], -q[1], -q[2], -q[3]], p);
+    return [dot(D.axes[0], b), dot(D.axes[1], b), dot(D.axes[2], b)];
+  }
+  // is p inside the box or behind it, seen from the eye? (slab test on the segment eye -> p)
+  function hidden(q, p, eye) {
+    var a = toBox(q, eye), b = toBox(q, p), lo = 0, hi = 1;
+    for (var i = 0; i < 3; i++) {
+      var d = b[i] - a[i], h = D.half[i] * (1 - 1e-9);
+      if (Math.abs(d) < 1e-300) { if (Math.abs(a[i]) > h) return false; continue; }
+      var u = (-h - a[i]) / d, v = (h - a[i]) / d;
+      lo = Math.max(lo, Math.min(u, v)); hi = Math.min(hi, Math.max(u, v));
+      if (lo > hi) return false;
+    }
+    return true;
+  }
+  // a straight line cut into pieces; the pieces hidden by the (convex, opaque) box are dropped,
+  // the others are drawn after the faces
+  function lineItems(items, q, eye, a, b, color, width, pieces) {
+    for (var i = 0; i < pieces; i++) {
+      var s0 = i / pieces, s1 = (i + 1) / pieces, sm = 0.5 * (s0 + s1);
+      var p = [a[0] + (b[0] - a[0]) * s0, a[1] + (b[1] - a[1]) * s0, a[2] + (b[2] - a[2]) * s0];
+      var r = [a[0] + (b[0] - a[0]) * s1, a[1] + (b[1] - a[1]) * s1, a[2] + (b[2] - a[2]) * s1];
+      var mid = [a[0] + (b[0] - a[0]) * sm, a[1] + (b[1] - a[1]) * sm, a[2] + (b[2] - a[2]) * sm];
+      if (hidden(q, mid, eye)) continue;
+      var cp = cam(p), cr = cam(r);
+      items.push({ z: Infinity, kind: 0, a: proj(cp), b: proj(cr), color: color, width: width });
+    }
+  }
+
+  function draw() {
+    var q = attitude(tcur);
+    ctx.fillStyle = "#ffffff";
+    ctx.fillRect(0, 0, W, H);
+    var items = [], i, k;
+    var ce = Math.cos(el), eye = [DIST * ce * Math.cos(az), DIST * ce * Math.sin(az), DIST * Math.sin(el)];
+    // space axes (faint), through the centre of mass
+    var AX = 1.15 * RS, names = ["x", "y", "z"];
+    for (i = 0; i < 3; i++) {
+      var e = [0, 0, 0]; e[i] = AX;
+      lineItems(items, q, eye, [-e[0], -e[1], -e[2]], e, "#c3c7cd", 1, 60);
+    }
+    // box faces: back-face culling, Lambert shading
+    var V = D.verts.map(function (v) { return cam(qrot(q, v)); });
+    D.faces.forEach(function (f) {
+      var nn = cam(qrot(q, f.normal));
+      var c = [0, 0, 0];
+      f.v.forEach(function (j) { c[0] += V[j][0] / 4; c[1] += V[j][1] / 4; c[2] += V[j][2] / 4; });
+      var view = [-c[0], -c[1], DIST - c[2]];
+      if (dot(nn, view) <= 0) return;
+      var shade = 0.5 + 0.5 * Math.max(0, dot(nn, LIGHT));
+      items.push({ z: c[2], kind: 1, pts: f.v.map(function (j) { return proj(V[j]); }),
+                   fill: rgb(f.color, shade), edge: rgb(f.color, 0.55 * shade) });
+    });
+    // angular momentum, fixed in space
+    var tip = null;
+    if (D.m) {
+      var mtip = [ARROW * D.m[0], ARROW * D.m[1], ARROW * D.m[2]];
+      lineItems(items, q, eye, [0, 0, 0], mtip, "#111111", 3, 60);
+      if (!hidden(q, mtip, eye)) tip = cam(mtip);
+    }
+    // painter's algorithm: far first (visible line pieces last)
+    items.sort(function (a, b) { return a.z - b.z; });
+    ctx.lineJoin = "round"; ctx.lineCap = "round";
+    for (k = 0; k < items.length; k++) {
+      var it = items[k];
+      if (it.kind === 0) {
+        ctx.strokeStyle = it.color; ctx.lineWidth = it.width;
+        ctx.beginPath(); ctx.moveTo(it.a[0], it.a[1]); ctx.lineTo(it.b[0], it.b[1]); ctx.stroke();
+      } else {
+        ctx.beginPath(); ctx.moveTo(it.pts[0][0], it.pts[0][1]);
+        for (i = 1; i < it.pts.length; i++) ctx.lineTo(it.pts[i][0], it.pts[i][1]);
+        ctx.closePath(); ctx.fillStyle = it.fill; ctx.fill();
+        ctx.strokeStyle = it.edge; ctx.lineWidth = 1; ctx.stroke();
+      }
+    }
+    // arrow head and labels on top
+    ctx.font = "13px system-ui, sans-serif"; ctx.textAlign = "center"; ctx.textBaseline = "middle";
+    if (tip) {
+      var base = cam([0.86 * ARROW * D.m[0], 0.86 * ARROW * D.m[1], 0.86 * ARROW * D.m[2]]);
+      var P = proj(tip), B = proj(base), dx = P[0] - B[0], dy = P[1] - B[1], L = Math.hypot(dx, dy) || 1;
+      var ux = dx / L, uy = dy / L, hw = 6;
+      ctx.fillStyle = "#111111"; ctx.beginPath(); ctx.moveTo(P[0] + 4 * ux, P[1] + 4 * uy);
+      ctx.lineTo(P[0] - 10 * ux - hw * uy, P[1] - 10 * uy + hw * ux);
+      ctx.lineTo(P[0] - 10 * ux + hw * uy, P[1] - 10 * uy - hw * ux); ctx.closePath(); ctx.fill();
+      ctx.fillText("m", P[0] + 16 * ux - 8 * uy, P[1] + 16 * uy + 8 * ux);
+    }
+    ctx.fillStyle = "#888888";
+    for (i = 0; i < 3; i++) {
+      var e2 = [0, 0, 0]; e2[i] = 1.2 * RS; var pp = proj(cam(e2));
+      ctx.fillText(names[i], pp[0], pp[1]);
+    }
+    document.getElementById("ep-time").textContent =
+      "t = " + tcur.toFixed(2) + " " + D.unit + "  (" + speed.toPrecision(3) + "\u00d7)";
+  }
+
+  var slider = document.getElementById("ep-slider"), btn = document.getElementById("ep-play");
+  btn.addEventListener("click", function () {
+    playing = !playing; btn.textContent = playing ? "Pause" : "Play"; last = null;
+  });
+  slider.addEventListener("input", function () {
+    tcur = t0 + span * slider.value / 1000; draw();
+  });
+  var drag = null;
+  cv.addEventListener("pointerdown", function (ev) { drag = [ev.clientX, ev.clientY]; cv.setPointerCapture(ev.pointerId); });
+  cv.addEventListener("pointerup", function () { drag = null; });
+  cv.addEventListener("pointermove", function (ev) {
+    if (!drag) return;
+    az -= 0.01 * (ev.clientX - drag[0]);
+    el = Math.max(-1.5, Math.min(1.5, el + 0.01 * (ev.clientY - drag[1])));
+    drag = [ev.clientX, ev.clientY]; if (!playing) draw();
+  });
+  function frame(ts) {
+    if (playing) {
+      if (last !== null && span > 0) {
+        tcur += (ts - last) / 1000 * speed;
+        if (tcur > t1) tcur = t0 + ((tcur - t0) % span);
+        slider.value = Math.round(1000 * (tcur - t0) / span);
+      }
+      last = ts;
+      draw();
+    }
+    window.requestAnimationFrame(frame);
+  }
+  draw();
+  window.requestAnimationFrame(frame);
+})();
+</script>
+</body>
+</html>
+"""
+
+
+# ---------------------------------------------------------------------------
+# GIF / MP4
+# ---------------------------------------------------------------------------
+def _writer(ext, fps):
+    from matplotlib import animation
+
+    if ext == "gif":
+        return animation.PillowWriter(fps=fps)
+    if not animation.FFMpegWriter.isAvailable():
+        import matplotlib
+
+        path = matplotlib.rcParams["animation.ffmpeg_path"]
+        found = shutil.which(path)
+        raise MissingDependencyError(
+            f"writing .mp4 needs the ffmpeg program, which was not found (matplotlib looks for {path!r}"
+            f"{'' if found is None else ' at ' + found}); install ffmpeg (e.g. 'apt-get install ffmpeg' or "
+            "'conda install ffmpeg') or write .html or .gif instead"
+        )
+    return animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+
+
+def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
+    mpl = import_matplotlib()
+    writer = _writer(ext, fps)  # fail early when ffmpeg is missing
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    from ..attitude.core import matrix_from_unit_quaternion
+
+    w, h = px
+    if ext == "mp4":  # yuv420p needs even sizes
+        w, h = w + w % 2, h + h % 2
+    dpi = 100
+    R0 = float(np.max(np.linalg.norm(verts, axis=1)))
+    arrow = 1.6 * R0
+    lim = 0.9 * max(arrow, 1.2 * R0)
+    light = np.array([0.25, 0.6, 0.75])
+    light /= np.linalg.norm(light)
+    base = np.array([_face_rgb(a, s) for _, _, a, s in faces], float) / 255.0
+    normals = np.array([nrm for _, nrm, _, _ in faces])
+    view = _view(mdir)
+    cam = _camera(view)
+    towards_viewer = cam[2]
+    half = 0.5 * sides
+    pieces = np.linspace(0.0, 1.0, 121)
+    mid = 0.5 * (pieces[1:] + pieces[:-1])
+    # straight lines drawn in pieces; pieces hidden by the box become NaN (gaps)
+    lines = [(-np.eye(3)[i] * lim, np.eye(3)[i] * lim, "#c3c7cd", 0.8) for i in range(3)]
+    if mdir is not None:
+        lines.append((np.zeros(3), arrow * mdir, "#111111", 2.2))
+    with mpl.rc_context({"font.size": 10}):
+        fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, layout="none")
+        FigureCanvasAgg(fig)
+        fig.patch.set_facecolor("white")
+        ax = fig.add_axes([0.0, 0.0, 1.0, 0.9], projection="3d")
+        ax.set_axis_off()
+        ax.set_proj_type("ortho")
+        ax.computed_zorder = False
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_zlim(-lim, lim)
+        try:
+            ax.set_box_aspect((1, 1, 1), zoom=1.35)
+        except TypeError:  # pragma: no cover - matplotlib < 3.7
+            ax.set_box_aspect((1, 1, 1))
+        ax.view_init(elev=view[1], azim=view[0])
+        for i in range(3):
+            ax.text(*(1.05 * np.eye(3)[i] * lim), "xyz"[i], color="#888888", ha="center", va="center", zorder=0)
+        coll = Poly3DCollection([verts[idx] for idx, *_ in faces], zorder=1, linewidths=0.6)
+        ax.add_collection3d(coll)
+        artists = []
+        for a, b, color, lw in lines:
+            (ln,) = ax.plot([], [], [], color=color, lw=lw, zorder=2, solid_capstyle="butt")
+            artists.append(ln)
+        tip = None
+        if mdir is not None:
+            tip = ax.scatter([arrow * mdir[0]], [arrow * mdir[1]], [arrow * mdir[2]], color="#111111",
+                             marker="o", s=16, zorder=3, depthshade=False)
+            ax.text(*(1.04 * arrow * mdir + 0.1 * lim * cam[1]), "m", color="#111111", zorder=3, ha="center",
+                    va="center", fontsize=11)
+        fig.text(0.5, 0.965, one.label + " — " + one.method, ha="center", va="center", fontsize=10)
+        ttext = fig.text(0.5, 0.925, "", ha="center", va="center", fontsize=9, color="#444444")
+        Rf = matrix_from_unit_quaternion(qf)
+        with atomic_path(out, suffix="." + ext) as tmp:
+            with writer.saving(fig, tmp, dpi):
+                for k in range(len(tf)):
+                    Rk = Rf[k]
+                    V = verts @ Rk.T
+                    N = normals @ Rk.T
+                    lam = np.clip((N @ cam.T) @ light, 0.0, None)
+                    shade = (0.5 + 0.5 * lam)[:, None]
+                    fc = np.clip(base * shade, 0, 1)
+                    coll.set_verts([V[idx] for idx, *_ in faces])
+                    coll.set_facecolor(fc)
+                    coll.set_edgecolor(fc * 0.55)
+                    for (a, b, _, _), ln in zip(lines, artists):
+                        P = a + pieces[:, None] * (b - a)
+                        hid = hidden_by_box(a + mid[:, None] * (b - a), Rk, half, one.axes, towards_viewer,
+                                            orthographic=True)
+                        # a point is kept when one of its two pieces is visible
+                        keep = np.zeros(len(P), bool)
+                        keep[:-1] |= ~hid
+                        keep[1:] |= ~hid
+                        Pn = np.where(keep[:, None], P, np.nan)
+                        ln.set_data_3d(Pn[:, 0], Pn[:, 1], Pn[:, 2])
+                    if tip is not None:
+                        tip.set_visible(not hidden_by_box((arrow * mdir)[None], Rk, half, one.axes,
+                                                          towards_viewer, orthographic=True)[0])
+                    ttext.set_text(f"t = {tf[k]:.2f} {one.time_unit}")
+                    writer.grab_frame()
+    return out

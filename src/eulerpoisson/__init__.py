@@ -1,4 +1,4 @@
-"""eulerpoisson: the free rigid body in the paper's rotation vector n = k tan(alpha/2).
+"""eulerpoisson: rigid-body rotation, the free body exactly (in the paper's rotation vector n = k tan(alpha/2)) and bodies under torque.
 
 Attitude sets centred on the Gibbs vector, the rigid-body model, the paper's
 formulations and its machine-checked audit, the exact (elliptic-function)
@@ -14,6 +14,8 @@ except PackageNotFoundError:  # pragma: no cover - running from a source tree
 
 from .attitude.core import Attitude
 from .model.body import RigidBody
+from .model.equations import Model
+from . import torques
 from .solvers import available_methods, solve
 from .trajectory import Trajectory
 from .model.formulations import FORMULATIONS, Formulation, formulation
@@ -23,12 +25,15 @@ from .errors import (
     InvalidInputError,
     MissingDependencyError,
     SingularChartError,
+    UnsupportedModelError,
 )
 
 __all__ = [
     "__version__",
     "Attitude",
     "RigidBody",
+    "Model",
+    "torques",
     "solve",
     "available_methods",
     "Trajectory",
@@ -39,5 +44,6 @@ __all__ = [
     "InvalidInputError",
     "InvalidInertiaError",
     "SingularChartError",
+    "UnsupportedModelError",
     "MissingDependencyError",
 ]

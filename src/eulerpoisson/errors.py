@@ -30,6 +30,10 @@ class InvalidInertiaError(InvalidInputError):
     triangle inequalities ``I_i + I_j >= I_k`` of a physical body."""
 
 
+class UnsupportedModelError(InvalidInputError):
+    """A solution method cannot run the model (its torques); the message names the methods that can."""
+
+
 class SingularChartError(EulerPoissonError, ValueError):
     """An attitude lies on the singular set of a chart.
 

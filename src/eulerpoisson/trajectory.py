@@ -20,6 +20,7 @@ from .io.atomic import atomic_path
 from .util.validate import as_float_array
 from .attitude.core import matrix_from_unit_quaternion, quaternion_make_continuous
 from .model.body import RigidBody
+from .model.equations import Model
 from .errors import EulerPoissonError, InvalidInputError, require
 
 __all__ = ["Trajectory", "FORMAT_VERSION"]
@@ -49,6 +50,10 @@ class Trajectory:
         Body angular velocities.
     body : RigidBody
         One body, or a batch whose shape broadcasts to ``batch``.
+    torque : Torque, list of Torque, or None
+        The torques of the motion (:mod:`eulerpoisson.torques`); None for the
+        free body. They define :attr:`energy` (with the potential),
+        :meth:`integrals` and :meth:`drift`. Keyword only.
     method : str
         Name of the method that produced it.
     options : dict, optional
@@ -68,7 +73,7 @@ class Trajectory:
 
     Attributes
     ----------
-    t, quaternion, omega, body, method, options, stats
+    t, quaternion, omega, body, model, method, options, stats
 
     Notes
     -----
@@ -77,7 +82,8 @@ class Trajectory:
     :attr:`gibbs_singular`), :attr:`M`, :attr:`m`, :attr:`energy`.
     """
 
-    def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None):
+    def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None, *,
+                 torque=None):
         self.t = as_float_array(t, "t")
         if self.t.ndim != 1:
             raise InvalidInputError(f"t must be a 1-D array of output times, shape (T,); got shape {self.t.shape}")
@@ -123,6 +129,12 @@ class Trajectory:
             inv[order] = np.arange(order.size)
             self.quaternion = np.take(qs, inv, axis=-2)
         self.body = body
+        self.model = Model(body, torque)
+        if self.model.batch_shape != () and np.broadcast_shapes(self.model.batch_shape, bshape) != bshape:
+            raise InvalidInputError(
+                f"the torque parameters' batch shape {self.model.batch_shape} does not broadcast to the "
+                f"trajectory's batch shape {bshape}"
+            )
         self.method = method
         self.options = dict(options or {})
         self.stats = dict(stats or {})
@@ -169,24 +181,66 @@ class Trajectory:
         return np.einsum("...ij,...j->...i", self.matrix, self.M)
 
     @property
-    def energy(self) -> np.ndarray:
-        r"""Kinetic energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega`, (*batch, T)."""
+    def kinetic_energy(self) -> np.ndarray:
+        r"""Kinetic energy :math:`\tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega`, (*batch, T)."""
         return 0.5 * np.sum(self.omega * self.M, -1)
 
+    @property
+    def potential_energy(self) -> np.ndarray:
+        r"""Potential energy :math:`U(t, R)` of the conservative torques, (*batch, T); 0 for the free body."""
+        if self.model.is_free:
+            return np.zeros(self.omega.shape[:-1])
+        T = self.t.shape[0]
+        Rt = np.moveaxis(self.matrix, -3, 0)  # time first: the torques' parameters broadcast over the batch
+        tt = self.t.reshape((T,) + (1,) * len(self.batch_shape))
+        U = np.zeros((T,) + self.batch_shape)
+        for tq in self.model.torques:
+            if tq.conservative:
+                U = U + tq.potential(tt, Rt, self.body.inertia)
+        return np.moveaxis(U, 0, -1)
+
+    @property
+    def energy(self) -> np.ndarray:
+        r"""Energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega + U`, (*batch, T).
+
+        The kinetic energy plus the potential of the conservative torques
+        (:attr:`kinetic_energy`, :attr:`potential_energy`); the kinetic energy
+        alone for the free body.
+        """
+        if self.model.is_free:
+            return self.kinetic_energy
+        return self.kinetic_energy + self.potential_energy
+
+    def integrals(self) -> dict[str, np.ndarray]:
+        """The conserved quantities of the trajectory's model at every output time, each (*batch, T).
+
+        See :meth:`eulerpoisson.Model.integrals` for which ones (energy and
+        spatial angular momentum for the free body; energy, vertical angular
+        momentum, and the Lagrange, Kovalevskaya or Goryachev–Chaplygin
+        integral for heavy tops; the Jacobi integral for the gravity gradient).
+        """
+        return self.model.integrals(self.t, self.quaternion, self.omega)
+
     def drift(self) -> dict[str, np.ndarray]:
-        r"""Relative drift of every integral of motion over the trajectory.
+        r"""Relative drift of every integral of motion of the model over the trajectory.
 
         Relative to the value at the first output time ``t[0]`` (the
-        initial state when ``t[0] = 0``): for the energy
+        initial state when ``t[0] = 0``). Free body: for the energy
         :math:`\max_t|E(t)-E_0|/|E_0|`, for :math:`|\mathbf m|` the same, and
         for each component :math:`\max_t|m_i(t)-m_i(t_0)|/|\mathbf m(t_0)|`.
-        Zero scales (a body at rest) give absolute values.
+        Under torque: each integral of :meth:`integrals`, the energy-like
+        ones (``energy``, ``jacobi``) relative to the sum of the magnitudes
+        of their terms at ``t[0]`` (kinetic plus :math:`|U|`, so a zero total
+        energy does not divide by zero), the angular momenta relative to
+        :math:`|\mathbf m(t_0)|`, the others to their own magnitude. Zero
+        scales (a body at rest) give absolute values.
 
         Returns
         -------
         dict
-            Keys ``"energy"``, ``"m_norm"``, ``"m_x"``, ``"m_y"``, ``"m_z"``,
-            each an array of the batch shape (a float for one body).
+            One entry per integral (free body: ``"energy"``, ``"m_norm"``,
+            ``"m_x"``, ``"m_y"``, ``"m_z"``), each an array of the batch shape
+            (a float for one body). Empty for a model with no known integral.
 
         Raises
         ------
@@ -200,20 +254,34 @@ class Trajectory:
                 "drift() is measured from the integrals at the first output time t[0], and this trajectory "
                 "has no output times (T = 0)"
             )
-        E = self.energy
-        m = self.m
-        mn = np.linalg.norm(m, axis=-1)
 
         def rel(x, ref, scale):
             s = np.where(scale > 0, scale, 1.0)
             return np.max(np.abs(x - ref[..., None]), axis=-1) / s
 
-        out = {
-            "energy": rel(E, E[..., 0], np.abs(E[..., 0])),
-            "m_norm": rel(mn, mn[..., 0], mn[..., 0]),
-        }
-        for i, c in enumerate("xyz"):
-            out[f"m_{c}"] = rel(m[..., i], m[..., 0, i], mn[..., 0])
+        if self.model.is_free:
+            E = self.energy
+            m = self.m
+            mn = np.linalg.norm(m, axis=-1)
+            out = {
+                "energy": rel(E, E[..., 0], np.abs(E[..., 0])),
+                "m_norm": rel(mn, mn[..., 0], mn[..., 0]),
+            }
+            for i, c in enumerate("xyz"):
+                out[f"m_{c}"] = rel(m[..., i], m[..., 0, i], mn[..., 0])
+        else:
+            vals = self.integrals()
+            mn0 = np.linalg.norm(self.m[..., 0, :], axis=-1)
+            kin0 = self.kinetic_energy[..., 0]
+            out = {}
+            for key, x in vals.items():
+                if key in ("energy", "jacobi"):
+                    scale = kin0 + np.abs(x[..., 0] - kin0)
+                elif key.startswith("m_") or key == "M3":
+                    scale = mn0
+                else:
+                    scale = np.abs(x[..., 0])
+                out[key] = rel(x, x[..., 0], scale)
         return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in out.items()}
 
     def particles(self, center0=(0.0, 0.0, 0.0), velocity0=(0.0, 0.0, 0.0)) -> np.ndarray:
@@ -282,7 +350,9 @@ class Trajectory:
             "m": (bdim + ("time", "axis"), flat(self.m, 2), {
                 "long_name": "spatial angular momentum m = R I Omega (space frame)", "units": "kg m2 s-1"}),
             "energy": (bdim + ("time",), flat(self.energy, 1), {
-                "long_name": "kinetic energy E = Omega.I Omega/2", "units": "J"}),
+                "long_name": ("kinetic energy E = Omega.I Omega/2" if self.model.is_free else
+                              "energy E = Omega.I Omega/2 + U (kinetic plus the potential of the torques)"),
+                "units": "J"}),
             "gibbs": (bdim + ("time", "axis"), flat(self.gibbs, 2), {
                 "long_name": "Gibbs rotation vector n = k tan(alpha/2) (paper eq. 1.8); NaN at alpha = pi",
                 "units": "1"}),
@@ -302,7 +372,9 @@ class Trajectory:
             "axis2": ("axis2", np.array(["x", "y", "z"])),
         }
         attrs = {
-            "title": f"free rigid body trajectory ({self.method})",
+            "title": (f"free rigid body trajectory ({self.method})" if self.model.is_free else
+                      f"rigid body under torque: {self.model.describe()} ({self.method})"),
+            "torque": json.dumps(_torque_records(self.model.torques)),
             "Conventions": "CF-1.10",
             "eulerpoisson_conventions": CONVENTIONS,
             "eulerpoisson_format_version": FORMAT_VERSION,
@@ -440,6 +512,7 @@ class Trajectory:
                 method=str(ds.attrs.get("method", "")),
                 options=options,
                 stats=stats,
+                torque=_read_torques(path, ds),
             )
         except (InvalidInputError, TypeError) as exc:  # name the file (the type is kept)
             raise type(exc)(f"{path}: {exc}") from exc
@@ -462,6 +535,42 @@ class Trajectory:
         b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
         span = f"[{self.t.min():.6g}, {self.t.max():.6g}]" if self.t.size else "[]"
         return f"Trajectory(method={self.method!r}, T={len(self.t)}, t={span}{b})"
+
+
+def _torque_records(torques) -> list[dict]:
+    """JSON-able records of the torques; a callable is recorded by name (it cannot be read back as code)."""
+    out = []
+    for tq in torques:
+        try:
+            out.append(tq.to_dict())
+        except NotImplementedError:
+            out.append({"kind": "unrecorded", "description": repr(tq)})
+    return out
+
+
+def _read_torques(path, ds):
+    """The torques of a file's ``torque`` attribute (absent: the free body)."""
+    from .model.torques import UnrecordedTorque, torque_from_dict
+
+    raw = ds.attrs.get("torque")
+    if raw is None or raw == "":
+        return None
+    try:
+        records = json.loads(str(raw))
+    except ValueError:
+        raise InvalidInputError(f"{path}: the torque attribute is not valid JSON: {str(raw)[:80]!r}") from None
+    if not isinstance(records, list):
+        raise InvalidInputError(f"{path}: the torque attribute must be a JSON list of records, got {str(raw)[:80]!r}")
+    out = []
+    for rec in records:
+        if isinstance(rec, dict) and rec.get("kind") == "unrecorded":
+            out.append(UnrecordedTorque(str(rec.get("description", ""))))
+        else:
+            try:
+                out.append(torque_from_dict(rec))
+            except (InvalidInputError, TypeError) as exc:
+                raise InvalidInputError(f"{path}: torque attribute: {exc}") from None
+    return out
 
 
 def _format_version(path, ver) -> int:

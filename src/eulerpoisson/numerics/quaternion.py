@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["qmul_components", "qmul", "qmul_first", "CONJUGATE"]
+from ..util.jit import jitable
+
+__all__ = ["qmul_components", "qmul", "qmul_first", "rotate_inverse", "CONJUGATE"]
 
 #: multiply a quaternion by this to conjugate it
 CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
+@jitable
 def qmul_components(pw, px, py, pz, qw, qx, qy, qz):
     r"""Hamilton product :math:`p\otimes q` of quaternions given by their components.
 
@@ -80,3 +83,21 @@ def qmul_first(p, q):
     out = np.empty(shape, dtype=np.result_type(p, q))
     out[0], out[1], out[2], out[3] = qmul_components(p[0], p[1], p[2], p[3], q[0], q[1], q[2], q[3])
     return out
+
+
+@jitable
+def rotate_inverse(qw, qx, qy, qz, s0, s1, s2):
+    r""":math:`R(q)^T\mathbf s`, the space vector ``s`` seen in the body frame, for a unit quaternion.
+
+    .. math:: R^T\mathbf s = \mathbf s + 2\big(w\,\mathbf c - \mathbf v\times\mathbf c\big),
+              \qquad \mathbf c = \mathbf s\times\mathbf v,\ \ q = (w, \mathbf v).
+
+    Scalars in, a tuple of three out (compiled inline into the kernels).
+    """
+    cx = s1 * qz - s2 * qy
+    cy = s2 * qx - s0 * qz
+    cz = s0 * qy - s1 * qx
+    dx = qy * cz - qz * cy
+    dy = qz * cx - qx * cz
+    dz = qx * cy - qy * cx
+    return s0 + 2.0 * (qw * cx - dx), s1 + 2.0 * (qw * cy - dy), s2 + 2.0 * (qw * cz - dz)

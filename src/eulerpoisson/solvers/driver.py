@@ -20,18 +20,19 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..trajectory import Trajectory
 from .problem import make_problem
-from .registry import get_method
+from .registry import check_supported, get_method
 
 __all__ = ["solve"]
 
 
-def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact", **options):
-    r"""Motion of free rigid bodies at the output times ``t``.
+def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method: str = "exact", **options):
+    r"""Motion of rigid bodies, free or under torque, at the output times ``t``.
 
     Parameters
     ----------
-    body : RigidBody or array_like
-        The body (or a batch of bodies); an array is passed to :class:`RigidBody`.
+    body : RigidBody, Model or array_like
+        The body (or a batch of bodies; an array is passed to
+        :class:`RigidBody`), or a :class:`~eulerpoisson.Model` with its torques.
     t : float or array_like, shape (T,)
         Output times, any order; negative times run the motion backwards
         from the initial state at ``t = 0``.
@@ -44,9 +45,14 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact
     attitude0 : Attitude or array_like, shape (..., 4), optional
         Initial attitude (unit quaternion); the identity by default, as for
         the paper's trajectories through the unit of SO(3) (eq. 1.2).
+    torque : Torque, callable, list of them, or None
+        Torques (:mod:`eulerpoisson.torques`: ``Gravity``, ``GravityGradient``,
+        ``BodyTorque``, ``SpaceTorque``; a callable ``torque(t, q, omega) ->
+        tau_body`` vectorized over the batch; a list is their sum). None: the
+        free body. For a heavy top the inertia is about the fixed point.
     method : str
         A name from :func:`available_methods`: ``"exact"`` (closed form,
-        default) and the integrators.
+        default: the free body and the Lagrange top) and the integrators.
     **options
         Method options (e.g. ``tol`` or ``dt``); unknown ones raise TypeError.
 
@@ -61,6 +67,9 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact
         Neither or both of ``omega0``/``m0``; an unknown option.
     InvalidInputError
         Unknown method, bad shapes, NaN/inf, a non-unit quaternion.
+    UnsupportedModelError
+        The method cannot run the model (e.g. ``method="exact"`` with a
+        gravity gradient); the message names the methods that can.
     InvalidInertiaError
         A non-physical inertia tensor.
 
@@ -70,10 +79,15 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact
     >>> tr = ep.solve([1.0, 2.0, 3.0], [0.0, 1.0, 10.0], omega0=[1.0, 0.1, 0.5])
     >>> tr.omega.shape
     (3, 3)
+    >>> top = ep.torques.Gravity(mass=1.0, center_of_mass=[0.0, 0.0, 0.1])
+    >>> tr = ep.solve([1.0, 1.0, 0.5], [0.0, 1.0], omega0=[0.0, 0.2, 20.0], torque=top, method="taylor")
+    >>> tr.omega.shape
+    (2, 3)
     """
     cls = get_method(method)
     m = cls(**options)
-    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0)
+    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, torque=torque)
+    check_supported(method, problem.model)
     if not cls.negative_times and np.any(problem.t < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
     start = _time.perf_counter()
@@ -85,6 +99,7 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, method: str = "exact
         quaternion=res.q,
         omega=res.omega,
         body=problem.body,
+        torque=problem.model.torques,
         method=method,
         options=dict(m.config),
         stats=stats,

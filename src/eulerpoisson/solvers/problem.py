@@ -13,6 +13,7 @@ import numpy as np
 from ..attitude.core import Attitude, as_quaternion
 from ..errors import InvalidInputError
 from ..model.body import RigidBody
+from ..model.equations import Model, as_model
 from ..numerics.quaternion import qmul
 from ..util.validate import as_float_array
 
@@ -21,12 +22,13 @@ __all__ = ["Problem", "make_problem", "compose_initial"]
 
 @dataclass(frozen=True)
 class Problem:
-    """A batch of free-rigid-body initial value problems.
+    """A batch of initial value problems for the model's equations of motion.
 
     Attributes
     ----------
-    body : RigidBody
-        Bodies, batch shape broadcastable to ``batch_shape``.
+    model : Model
+        The equations: bodies and torques, batch shape broadcastable to
+        ``batch_shape``.
     q0 : ndarray, shape (*batch_shape, 4)
         Initial attitudes (unit quaternions, scalar first).
     omega0 : ndarray, shape (*batch_shape, 3)
@@ -35,10 +37,15 @@ class Problem:
         Output times, any order, negative allowed.
     """
 
-    body: RigidBody
+    model: Model
     q0: np.ndarray
     omega0: np.ndarray
     t: np.ndarray
+
+    @property
+    def body(self) -> RigidBody:
+        """The bodies (the free-body part of :attr:`model`)."""
+        return self.model.body
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
@@ -63,14 +70,6 @@ class Problem:
         return np.einsum("...ij,...j->...i", self.inertia, self.omega0)
 
 
-def _as_body(body) -> RigidBody:
-    if isinstance(body, RigidBody):
-        return body
-    if isinstance(body, (str, bytes)) or body is None:
-        raise TypeError(f"body must be a RigidBody or an inertia array, got {body!r}")
-    return RigidBody(body)
-
-
 def _as_times(t) -> np.ndarray:
     ta = as_float_array(t, "t")
     if ta.ndim > 1:
@@ -78,7 +77,7 @@ def _as_times(t) -> np.ndarray:
     return np.atleast_1d(ta)
 
 
-def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
+def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, torque=None) -> Problem:
     """Validate and broadcast the arguments of :func:`solve` into a :class:`Problem`.
 
     Raises
@@ -86,7 +85,8 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
     TypeError, InvalidInputError
         See :func:`solve`.
     """
-    body = _as_body(body)
+    model = as_model(body, torque)
+    body = model.body
     times = _as_times(t)
     if (omega0 is None) == (m0 is None):
         raise TypeError("give exactly one of omega0 (body angular velocity) or m0 (spatial angular momentum)")
@@ -105,10 +105,11 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
     name, v0 = ("omega0", omega0) if omega0 is not None else ("m0", m0)
     v0 = as_float_array(v0, name, (3,))
     try:
-        shape = np.broadcast_shapes(q0.shape[:-1], v0.shape[:-1], body.batch_shape)
+        shape = np.broadcast_shapes(q0.shape[:-1], v0.shape[:-1], model.batch_shape)
     except ValueError:
         raise InvalidInputError(
             f"the batch shapes do not broadcast: body {body.batch_shape} (inertia {body.inertia.shape}), "
+            f"model {model.batch_shape}, "
             f"{name} {v0.shape[:-1]} (array {v0.shape}), attitude0 {q0.shape[:-1]} (array {q0.shape}); "
             f"leading axes must broadcast as in numpy"
         ) from None
@@ -120,16 +121,19 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None) -> Problem:
         w0 = np.einsum("...ij,...j->...i", body.inertia_inv, M)
     q0 = np.broadcast_to(q0, shape + (4,)).copy()
     w0 = np.broadcast_to(w0, shape + (3,)).copy()
-    return Problem(body=body, q0=q0, omega0=w0, t=times)
+    return Problem(model=model, q0=q0, omega0=w0, t=times)
 
 
 def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
     r"""Attitudes :math:`q_0\otimes q_\mathrm{rel}(t)` for relative motions starting at the identity.
 
     ``q_rel`` has shape (*batch_shape, T, 4); left invariance of the free body
-    makes this the motion from ``q0``. When every ``q0`` is the identity,
+    makes this the motion from ``q0`` (a free-body shortcut: only valid when
+    ``problem.model.is_free``, which is checked). When every ``q0`` is the identity,
     ``q_rel`` is returned as it is (the product would only copy it).
     """
+    if not problem.model.is_free:
+        raise ValueError("compose_initial is a free-body shortcut (left invariance); the model has torques")
     q0 = problem.q0
     if np.all(q0[..., 0] == 1.0) and not np.any(q0[..., 1:]):
         return q_rel

@@ -14,10 +14,19 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, UnsupportedModelError
+from ..model.equations import Model
 from .problem import Problem
 
-__all__ = ["Method", "MethodResult", "register_method", "available_methods", "get_method"]
+__all__ = [
+    "Method",
+    "MethodResult",
+    "register_method",
+    "available_methods",
+    "get_method",
+    "methods_supporting",
+    "check_supported",
+]
 
 _REGISTRY: dict[str, type["Method"]] = {}
 
@@ -81,6 +90,16 @@ class Method:
     def validate(self) -> None:
         """Check ``self.config``; override to validate option values."""
 
+    @classmethod
+    def supports(cls, model: Model) -> str | None:
+        """Why this method cannot run ``model`` (a sentence), or None when it can.
+
+        The default: the free body only. Methods that handle torques override it.
+        """
+        if model.is_free:
+            return None
+        return f"it solves the free body only (the model has {model.describe()})"
+
     def nominal_order(self) -> int | None:
         """Nominal order of this configured instance (may depend on options such as ``scheme``)."""
         return self.order
@@ -100,6 +119,27 @@ def register_method(cls: type[Method]) -> type[Method]:
 def available_methods() -> list[str]:
     """Names accepted by ``solve(..., method=...)``."""
     return sorted(_REGISTRY)
+
+
+def methods_supporting(model: Model) -> list[str]:
+    """Names of the registered methods that can run ``model``."""
+    return sorted(name for name, cls in _REGISTRY.items() if cls.supports(model) is None)
+
+
+def check_supported(name: str, model: Model) -> None:
+    """Raise :class:`~eulerpoisson.errors.UnsupportedModelError` when method ``name`` cannot run ``model``.
+
+    Raises
+    ------
+    UnsupportedModelError
+        Naming the method, the reason and the methods that can run the model.
+    """
+    reason = get_method(name).supports(model)
+    if reason is None:
+        return
+    able = methods_supporting(model)
+    hint = f"methods that can: {', '.join(able)}" if able else "no registered method can"
+    raise UnsupportedModelError(f"method {name!r} cannot run this model: {reason}; {hint}")
 
 
 def get_method(name: str) -> type[Method]:

@@ -78,6 +78,8 @@ __all__ = [
     "body_setup",
     "body_eval",
     "motion_kernel",
+    "free_flow",
+    "equilibrium_eval",
     "constants_kernel",
 ]
 
@@ -1204,6 +1206,30 @@ def body_eval(cst, t):
 # =============================================================================
 # entry points
 # =============================================================================
+def equilibrium_eval(i0, i1, i2, m0, m1, m2, t):
+    """``(M_0, M_1, M_2, q_w, q_x, q_y, q_z)`` of a relative equilibrium (uniform rotation about Omega = M/I)."""
+    o0 = m0 / i0
+    o1 = m1 / i1
+    o2 = m2 / i2
+    w = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+    ws = w if w > 0.0 else 1.0
+    half = 0.5 * w * t
+    sh = math.sin(half)
+    return m0, m1, m2, math.cos(half), sh * (o0 / ws), sh * (o1 / ws), sh * (o2 / ws)
+
+
+def free_flow(i0, i1, i2, m0, m1, m2, t, cst):
+    """The exact free-body flow over time ``t`` from body momentum ``(m0, m1, m2)`` (principal frame).
+
+    Returns ``(M_0, M_1, M_2, q_w, q_x, q_y, q_z)``: the momentum at ``t`` and
+    the rotation from the identity (``cst`` is scratch of length
+    :data:`N_CONST`). Used as the kinetic step of splitting methods.
+    """
+    if body_setup(i0, i1, i2, m0, m1, m2, cst):
+        return equilibrium_eval(i0, i1, i2, m0, m1, m2, t)
+    return body_eval(cst, t)
+
+
 def motion_kernel(inertia, M0, t, Mout, qout):
     """Fill ``Mout`` (nb, T, 3) and ``qout`` (nb, T, 4) for bodies (nb, 3) and times (T,).
 
@@ -1222,25 +1248,15 @@ def motion_kernel(inertia, M0, t, Mout, qout):
         m2 = M0[b, 2]
         if body_setup(i0, i1, i2, m0, m1, m2, cst):
             # relative equilibrium: M constant, uniform rotation about Omega = M0 / I
-            o0 = m0 / i0
-            o1 = m1 / i1
-            o2 = m2 / i2
-            w = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-            ws = w if w > 0.0 else 1.0
-            a0 = o0 / ws
-            a1 = o1 / ws
-            a2 = o2 / ws
-            hw = 0.5 * w
             for j in range(T):
-                half = hw * t[j]
-                sh = math.sin(half)
-                Mout[b, j, 0] = m0
-                Mout[b, j, 1] = m1
-                Mout[b, j, 2] = m2
-                qout[b, j, 0] = math.cos(half)
-                qout[b, j, 1] = sh * a0
-                qout[b, j, 2] = sh * a1
-                qout[b, j, 3] = sh * a2
+                r0, r1, r2, r3, r4, r5, r6 = equilibrium_eval(i0, i1, i2, m0, m1, m2, t[j])
+                Mout[b, j, 0] = r0
+                Mout[b, j, 1] = r1
+                Mout[b, j, 2] = r2
+                qout[b, j, 0] = r3
+                qout[b, j, 1] = r4
+                qout[b, j, 2] = r5
+                qout[b, j, 3] = r6
         else:
             for j in range(T):
                 r0, r1, r2, r3, r4, r5, r6 = body_eval(cst, t[j])
@@ -1350,5 +1366,7 @@ if USE_NUMBA:  # pragma: no branch
     _qmul = _jit(_qmul)
     body_setup = _jit(body_setup)
     body_eval = _jit(body_eval)
+    equilibrium_eval = _jit(equilibrium_eval)
+    free_flow = _jit(free_flow)
     motion_kernel = _jit(motion_kernel)
     constants_kernel = _jit(constants_kernel)

@@ -204,7 +204,16 @@ class RK(Method):
         wscale = wscale if wscale > 0 else 1.0
         return rtol, np.r_[np.full(n_attitude, tol), np.full(3, tol * wscale)]
 
+    @classmethod
+    def supports(cls, model) -> str | None:
+        bad = [t for t in model.torques if t.kind == "unrecorded"]
+        if bad:
+            return f"the torque {bad[0].description} was not recorded (a Python function read back from a file)"
+        return None
+
     def run(self, problem: Problem) -> MethodResult:
+        if not problem.model.is_free:
+            return self._run_torque(problem)
         cfg = self.config
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
@@ -339,6 +348,121 @@ class RK(Method):
             ye = sol.y[:, -1]
             qc = ch.qmul(qc, ch.quaternion_from_gibbs(ye[:3, None]))
             qc = qc / np.sqrt(ch.dot4(qc, qc))
+            y = np.r_[np.zeros(3), ye[3:]]
+            tcur = stop
+            stats["chart_changes"] += 1
+        return qo, wo
+
+    # ------------------------------------------------------------------
+    # under torque: the model's right-hand side in the body frame
+    # ------------------------------------------------------------------
+    def _run_torque(self, problem: Problem) -> MethodResult:
+        cfg = self.config
+        bshape = problem.batch_shape
+        B = int(np.prod(bshape, dtype=int))
+        T = problem.t.shape[0]
+        t = problem.t
+        q0 = problem.q0.reshape(B, 4)
+        w0 = problem.omega0.reshape(B, 3)
+        qout = np.empty((B, T, 4))
+        wout = np.empty((B, T, 3))
+        stats = {"integrator": cfg["integrator"], "formulation": cfg["formulation"], "nfev": 0, "njev": 0,
+                 "steps": 0, "chart_changes": 0}
+        branches = [np.flatnonzero(t >= 0), np.flatnonzero(t < 0)]
+        for b in range(B):
+            model = problem.model.element(np.unravel_index(b, bshape) if bshape else ())
+            stats["_nfev_body"] = 0
+            for idx in branches:
+                if idx.size == 0:
+                    continue
+                if cfg["formulation"] == "quaternion":
+                    q, w = self._solve_quaternion_model(model, q0[b], w0[b], t[idx], stats)
+                else:
+                    q, w = self._solve_gibbs_model(model, q0[b], w0[b], t[idx], stats)
+                qout[b, idx] = q.T
+                wout[b, idx] = w.T
+        stats.pop("_nfev_body", None)
+        return MethodResult(q=qout.reshape(bshape + (T, 4)), omega=wout.reshape(bshape + (T, 3)), stats=stats)
+
+    def _solve_quaternion_model(self, model, q0, w0, times, stats):
+        rtol, atol = self._tolerances(w0, 4)
+        if not np.any(w0):  # a body released from rest: scale the rate by the torque's natural frequency
+            rtol, atol = self._tolerances(self._rate_scale(model, q0), 4)
+
+        def f(t, y):
+            qd, wd = model.rhs(t, y[:4], y[4:])
+            return np.concatenate([qd, wd])
+
+        y0 = np.r_[q0, w0]
+        tend = times[np.argmax(np.abs(times))]
+        if tend == 0:
+            y = np.repeat(y0[:, None], times.size, axis=1)
+        else:
+            sol = self._call(f, 0.0, float(tend), y0, rtol, atol, stats)
+            y = sol.sol(times)
+        q = y[:4] / np.sqrt(np.sum(y[:4] ** 2, axis=0))
+        return q, y[4:]
+
+    @staticmethod
+    def _rate_scale(model, q0):
+        """A rate for the tolerance of Omega when Omega0 = 0: sqrt(|I^-1 tau(0)|)."""
+        tau = model.torque(0.0, q0, np.zeros(3))
+        acc = np.linalg.norm(model.body.inertia_inv @ tau)
+        return np.full(3, math.sqrt(acc) / math.sqrt(3.0) if acc > 0 else 0.0)
+
+    def _solve_gibbs_model(self, model, q0, w0, times, stats):
+        r"""(n, Omega) in charts R = R_c R(n); the torque sees the full attitude R_c R(n)."""
+        rtol, atol = self._tolerances(w0 if np.any(w0) else self._rate_scale(model, q0), 3)
+        thr = self.config["chart_threshold"]
+        thr2 = thr * thr
+
+        def make_rhs(qc):
+            def f(t, y):
+                n = y[:3]
+                o = y[3:]
+                no = n @ o
+                ndot = 0.5 * (o + np.cross(n, o) + no * n)
+                qn = ch.quaternion_from_gibbs(n[:, None])[:, 0]
+                q = ch.qmul(qc[:, None], qn[:, None])[:, 0]
+                return np.concatenate([ndot, model.omega_dot(t, q, o)])
+
+            return f
+
+        def event(t, y):
+            return y[0] * y[0] + y[1] * y[1] + y[2] * y[2] - thr2
+
+        event.terminal = True
+        event.direction = 1.0
+        order = np.argsort(np.abs(times), kind="stable")
+        ts = times[order]
+        qo = np.empty((4, times.size))
+        wo = np.empty((3, times.size))
+        qc = q0.copy()
+        y = np.r_[np.zeros(3), w0]
+        tcur = 0.0
+        tend = float(ts[-1])
+        k = 0
+        while True:
+            if tcur == tend:
+                nrem = times.size - k
+                ys = np.repeat(y[:, None], nrem, axis=1)
+                sol = None
+            else:
+                sol = self._call(make_rhs(qc), tcur, tend, y, rtol, atol, stats, events=event)
+                stop = float(sol.t[-1])
+                nrem = int(np.sum(np.abs(ts[k:]) <= abs(stop)))
+                ys = sol.sol(ts[k:k + nrem]) if nrem else np.empty((6, 0))
+            if nrem:
+                sel = order[k:k + nrem]
+                qq = ch.qmul(qc[:, None], ch.quaternion_from_gibbs(ys[:3]))
+                qo[:, sel] = qq / np.sqrt(ch.dot4(qq, qq))
+                wo[:, sel] = ys[3:]
+                k += nrem
+            if k >= times.size or sol is None:
+                break
+            ye = sol.y[:, -1]
+            qc = ch.qmul(qc[:, None], ch.quaternion_from_gibbs(ye[:3, None]))[:, 0]
+            qc = qc / np.sqrt(qc @ qc)
             y = np.r_[np.zeros(3), ye[3:]]
             tcur = stop
             stats["chart_changes"] += 1

@@ -97,7 +97,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import EulerPoissonError, InvalidInputError
+from ...attitude.core import quaternion_from_rotation_matrix
+from ...errors import EulerPoissonError, InvalidInputError, UnsupportedModelError
+from ...numerics.quaternion import qmul
+from ...util.jit import USE_NUMBA
 from ..problem import Problem
 from ..registry import Method, MethodResult, register_method
 from .. import charts as ch
@@ -107,7 +110,11 @@ __all__ = ["Symplectic", "GaussTableau", "gauss_tableau", "gauss_step", "splitti
 _EPS = np.finfo(float).eps
 
 #: schemes and their orders
-SCHEMES = {"gauss2": 2, "gauss4": 4, "gauss6": 6, "splitting": 2, "splitting4": 4}
+SCHEMES = {"gauss2": 2, "gauss4": 4, "gauss6": 6, "splitting": 2, "splitting4": 4, "exact_splitting": 2,
+           "exact_splitting4": 4}
+
+#: the schemes that run bodies under torque
+TORQUE_SCHEMES = ("exact_splitting", "exact_splitting4")
 
 #: canonical variables of the Gauss schemes
 VARIABLES = ("gibbs", "quaternion")
@@ -457,11 +464,16 @@ class Symplectic(Method):
 
     Options
     -------
-    scheme : str
-        ``"gauss2"``, ``"gauss4"`` (default), ``"gauss6"`` (Gauss-Legendre
+    scheme : str or None
+        ``"gauss2"``, ``"gauss4"``, ``"gauss6"`` (Gauss-Legendre
         collocation of orders 2, 4, 6 in canonical variables),
         ``"splitting"`` (order 2) or ``"splitting4"`` (order 4), the explicit
-        Lie-Poisson splitting in :math:`(R, \mathbf M)`.
+        Lie-Poisson splitting in :math:`(R, \mathbf M)`, and, for bodies under
+        torque, ``"exact_splitting"`` (order 2) or ``"exact_splitting4"``
+        (order 4): the exact free-body flow composed with torque kicks
+        (:mod:`.exact_splitting`; Celledoni, Fassò, Säfström and Zanna 2008).
+        None (default): ``"gauss4"`` for the free body, ``"exact_splitting4"``
+        under torque.
     variables : str
         Canonical variables of the Gauss schemes: ``"quaternion"`` (default:
         the homogeneous coordinates :math:`(q, p)\in T^*\mathbb R^4` of the
@@ -498,7 +510,7 @@ class Symplectic(Method):
 
     name = "symplectic"
     options = {
-        "scheme": "gauss4",
+        "scheme": None,
         "variables": "quaternion",
         "dt": None,
         "max_iter": 100,
@@ -513,7 +525,7 @@ class Symplectic(Method):
     def validate(self) -> None:
         cfg = self.config
         scheme = cfg["scheme"]
-        if not isinstance(scheme, str) or scheme not in SCHEMES:
+        if scheme is not None and (not isinstance(scheme, str) or scheme not in SCHEMES):
             raise InvalidInputError(
                 f"symplectic: unknown scheme {scheme!r}; choose one of {', '.join(SCHEMES)}"
             )
@@ -532,14 +544,31 @@ class Symplectic(Method):
         cfg["max_steps"] = ch.check_count("symplectic", "max_steps", cfg["max_steps"])
 
     def nominal_order(self) -> int:
-        """Order of convergence of the configured scheme (2, 4 or 6)."""
-        return SCHEMES[self.config["scheme"]]
+        """Order of convergence of the configured scheme (2, 4 or 6; 4 for the default)."""
+        return SCHEMES[self.config["scheme"] or "gauss4"]
+
+    @classmethod
+    def supports(cls, model) -> str | None:
+        if model.is_free:
+            return None
+        if any(t.depends_on_omega for t in model.torques) or model.polynomial() is None:
+            return ("its splitting kicks with torques that depend on the time and the attitude only (Gravity, "
+                    f"GravityGradient, BodyTorque, SpaceTorque), and the model has {model.describe()}")
+        return None
 
     # ------------------------------------------------------------------
     def run(self, problem: Problem) -> MethodResult:
         from . import kernels as _k
 
         cfg = self.config
+        scheme = cfg["scheme"] or ("gauss4" if problem.model.is_free else "exact_splitting4")
+        if scheme in TORQUE_SCHEMES:
+            return self._run_exact_splitting(problem, SCHEMES[scheme], scheme)
+        if not problem.model.is_free:
+            raise UnsupportedModelError(
+                f"symplectic: scheme {scheme!r} solves the free body only; under torque use scheme="
+                f"'exact_splitting' (order 2) or 'exact_splitting4' (order 4)"
+            )
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
         q0 = np.ascontiguousarray(problem.q0.reshape(B, 4).T)
@@ -561,7 +590,6 @@ class Symplectic(Method):
         if B:
             ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
                                  "raise max_steps or dt, or shorten the times")
-        scheme = cfg["scheme"]
         stats = {"scheme": scheme, "dt": dt}
         compiled = _k.USE_NUMBA and B > 0 and (not scheme.startswith("gauss") or cfg["variables"] == "quaternion")
         stats["compiled"] = bool(compiled)
@@ -694,3 +722,43 @@ class Symplectic(Method):
         q, w, nsteps = _k.run_splitting(q0, moments * w0, inv_m, splitting_sequence(order), t, dt)
         stats["chart_changes"] = 0
         return (q, w), nsteps
+
+    def _run_exact_splitting(self, problem: Problem, order: int, scheme: str) -> MethodResult:
+        """The exact free flow composed with torque kicks, in the principal frame (:mod:`.exact_splitting`)."""
+        from ..taylor.torque import polynomial_data
+        from .exact_splitting import run_exact_splitting
+
+        cfg = self.config
+        bshape = problem.batch_shape
+        B = int(np.prod(bshape, dtype=int))
+        T = problem.t.shape[0]
+        P = np.ascontiguousarray(problem.principal_axes.reshape(B, 3, 3))
+        D = np.ascontiguousarray(problem.principal_moments.reshape(B, 3))
+        qP = quaternion_from_rotation_matrix(P)
+        q0 = problem.q0.reshape(B, 4)
+        w0 = problem.omega0.reshape(B, 3)
+        qp0 = qmul(q0, qP)
+        Mp0 = D * np.einsum("bji,bj->bi", P, w0)
+        data = polynomial_data(problem.model.polynomial(), bshape)
+        data.tau0 = np.ascontiguousarray(np.einsum("bji,bj->bi", P, data.tau0))
+        data.L = np.ascontiguousarray(np.einsum("bji,bvjk,bkl->bvil", P, data.L, P))
+        dt = cfg["dt"]
+        if dt is None:
+            rate = np.sqrt(np.sum(w0 * w0, axis=-1))
+            if B and not problem.model.is_free:
+                tau = problem.model.torque(0.0, problem.q0, problem.omega0).reshape(B, 3)
+                acc = np.einsum("bij,bj->bi", np.linalg.inv(problem.inertia.reshape(B, 3, 3)), tau)
+                rate = np.maximum(rate, np.sqrt(np.sqrt(np.sum(acc * acc, axis=-1))))
+            wmax = float(np.max(rate)) if B else 0.0
+            dt = DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
+        dt = float(dt)
+        if B:
+            ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
+                                 "raise max_steps or dt, or shorten the times")
+        qp, Mp, nsteps = run_exact_splitting(D, qp0, Mp0, data, problem.t, dt, order)
+        if not (np.all(np.isfinite(qp)) and np.all(np.isfinite(Mp))):
+            raise EulerPoissonError("symplectic: the state became non-finite (the step dt is far too large)")
+        q = qmul(qp, (qP * np.array([1.0, -1.0, -1.0, -1.0]))[:, None, :])
+        w = np.einsum("bij,btj->bti", P, Mp / D[:, None, :])
+        stats = {"scheme": scheme, "dt": dt, "steps": nsteps, "compiled": bool(USE_NUMBA), "chart_changes": 0}
+        return MethodResult(q=q.reshape(bshape + (T, 4)), omega=w.reshape(bshape + (T, 3)), stats=stats)

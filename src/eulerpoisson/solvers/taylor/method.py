@@ -541,7 +541,16 @@ class Taylor(Method):
         as_scalar(c["max_steps"], "max_steps", positive=True, integer=True)
         as_scalar(c["chart_threshold"], "chart_threshold", nonnegative=True)
 
+    @classmethod
+    def supports(cls, model) -> str | None:
+        if model.is_free or model.polynomial() is not None:
+            return None
+        return ("taylor expands polynomial torques (Gravity, GravityGradient, BodyTorque, SpaceTorque) in Taylor "
+                f"series, and the model has {model.describe()}, which is not one")
+
     def run(self, problem: Problem) -> MethodResult:
+        if not problem.model.is_free:
+            return self._run_torque(problem)
         c = self.config
         bshape = problem.batch_shape
         B = int(np.prod(bshape)) if bshape else 1
@@ -564,5 +573,31 @@ class Taylor(Method):
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
             q = qmul(q, qPc[:, None, :])
             om = np.einsum("bij,btj->bti", P, om)
+        T = problem.t.shape[0]
+        return MethodResult(q=q.reshape(bshape + (T, 4)), omega=om.reshape(bshape + (T, 3)), stats=stats)
+
+    def _run_torque(self, problem: Problem) -> MethodResult:
+        """Bodies under polynomial torques: (q, Omega) with Poisson vectors (:mod:`.torque`)."""
+        from .torque import integrate_polynomial, polynomial_data
+
+        c = self.config
+        bshape = problem.batch_shape
+        B = int(np.prod(bshape, dtype=int))
+        data = polynomial_data(problem.model.polynomial(), bshape)
+        inertia = np.ascontiguousarray(problem.inertia.reshape(B, 3, 3))
+        order = c["order"] if c["order"] is not None else (DEFAULT_FIXED_ORDER if c["dt"] is not None
+                                                           else auto_order(float(c["tol"])))
+        q, om, stats, status = integrate_polynomial(
+            inertia, problem.q0.reshape(B, 4), problem.omega0.reshape(B, 3), data, problem.t,
+            tol=float(c["tol"]), order=int(order), dt=c["dt"], max_steps=int(c["max_steps"]),
+        )
+        if np.any(status == 1):
+            b = int(np.flatnonzero(status == 1)[0])
+            raise EulerPoissonError(
+                f"taylor: max_steps={c['max_steps']} exhausted for body {b}; raise max_steps or tol, or shorten the times"
+            )
+        if np.any(status == 2):
+            b = int(np.flatnonzero(status == 2)[0])
+            raise EulerPoissonError(f"taylor: the state of body {b} became non-finite (the motion diverges)")
         T = problem.t.shape[0]
         return MethodResult(q=q.reshape(bshape + (T, 4)), omega=om.reshape(bshape + (T, 3)), stats=stats)

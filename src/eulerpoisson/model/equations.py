@@ -1,0 +1,496 @@
+r"""The equations of motion as one object: :class:`Model` = a body plus torques.
+
+Every solution method consumes a :class:`Model`: the free-body part (the
+inertia tensor, :class:`~eulerpoisson.RigidBody`) and zero or more torques
+(:mod:`eulerpoisson.torques`). The model gives
+
+- the vector field of :math:`(q, \boldsymbol\Omega)` (:meth:`Model.rhs`),
+
+  .. math:: \dot q = \tfrac12\,q\otimes(0, \boldsymbol\Omega), \qquad
+            I\dot{\boldsymbol\Omega} = (I\boldsymbol\Omega)\times\boldsymbol\Omega
+            + \boldsymbol\tau(t, R, \boldsymbol\Omega)
+
+  (paper eq. 1.4-1.5 with the torque of the Euler–Poisson equations);
+- the energy with the potential of the conservative torques
+  (:meth:`Model.energy`), and the conserved quantities of the model
+  (:meth:`Model.integrals`), recognized from the data: the free body's energy
+  and spatial angular momentum; for a heavy top the energy and the vertical
+  component of :math:`\mathbf m`, plus :math:`M_3` for a Lagrange top, the
+  Kovalevskaya integral when :math:`I_1 = I_2 = 2I_3` with the centre of mass
+  in the equatorial plane, the Goryachev–Chaplygin integral when
+  :math:`I_1 = I_2 = 4I_3` on its level :math:`\mathbf m\cdot\hat{\mathbf g} = 0`;
+  the Jacobi integral for the gravity gradient;
+- what a method needs to decide whether it can run the model
+  (:attr:`Model.is_free`, :meth:`Model.polynomial`, :meth:`Model.potential`,
+  :meth:`Model.lagrange_top`).
+
+The free-body shortcuts of the methods (the principal frame, left
+invariance, chart restarts) are taken only when :attr:`Model.is_free`.
+
+References
+----------
+Paper eq. 1.4-1.5. Borisov and Mamaev, *Rigid Body Dynamics* (2018), §2.1-2.3
+(the Euler–Poisson equations and their integrable cases). S. Kovalevskaya,
+"Sur le problème de la rotation d'un corps solide autour d'un point fixe",
+Acta Math. 12 (1889) 177-232. D. N. Goryachev (1900), S. A. Chaplygin (1901).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from ..numerics.quaternion import qmul_components
+from .body import RigidBody
+from .torques import Gravity, GravityGradient, PolynomialTorque, Torque, as_torques
+
+__all__ = ["Model", "LagrangeTop", "euler_coefficients", "as_model"]
+
+#: relative tolerance for recognizing equal moments and a centre of mass on an axis or plane
+SYMMETRY_RTOL = 1e-12
+
+
+def euler_coefficients(moments):
+    r"""Euler's coefficients :math:`a_i = (I_j - I_k)/I_i` ((i, j, k) cyclic), the one copy.
+
+    Euler's equations in the principal frame read
+    :math:`\dot\Omega_i = a_i\Omega_j\Omega_k`.
+
+    Parameters
+    ----------
+    moments : array_like, shape (3, ...) (component first)
+
+    Returns
+    -------
+    tuple of three arrays
+
+    References
+    ----------
+    Paper eq. 1.5.
+    """
+    I1, I2, I3 = moments[0], moments[1], moments[2]
+    return (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
+
+
+def _matrix(q):
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    R = np.empty(q.shape[:-1] + (3, 3))
+    R[..., 0, 0] = w * w + x * x - y * y - z * z
+    R[..., 0, 1] = 2 * (x * y - w * z)
+    R[..., 0, 2] = 2 * (x * z + w * y)
+    R[..., 1, 0] = 2 * (x * y + w * z)
+    R[..., 1, 1] = w * w - x * x + y * y - z * z
+    R[..., 1, 2] = 2 * (y * z - w * x)
+    R[..., 2, 0] = 2 * (x * z - w * y)
+    R[..., 2, 1] = 2 * (y * z + w * x)
+    R[..., 2, 2] = w * w - x * x - y * y + z * z
+    return R
+
+
+def _mv(A, v):
+    return np.einsum("...ij,...j->...i", A, v)
+
+
+def _dot(a, b):
+    return np.einsum("...i,...i->...", a, b)
+
+
+class LagrangeTop(NamedTuple):
+    r"""A heavy symmetric top with its centre of mass on the symmetry axis, in its own frame.
+
+    The body frame is rotated by :math:`P` (``frame``, :math:`\det P = 1`) so
+    that the symmetry axis is :math:`\mathbf e_3`: :math:`I = P\,\mathrm{diag}(A, A, C)P^T`,
+    :math:`\mathbf c = P(0, 0, \ell)`.
+    """
+
+    A: np.ndarray
+    C: np.ndarray
+    mass: np.ndarray
+    ell: np.ndarray
+    g: np.ndarray
+    frame: np.ndarray
+
+
+class Model:
+    r"""The equations of motion: a rigid body and the torques acting on it.
+
+    Parameters
+    ----------
+    body : RigidBody or array_like
+        The body or a batch of bodies (an array is passed to :class:`RigidBody`).
+        For a heavy top the inertia is about the fixed point (the body origin).
+    torque : Torque, callable, list of them, or None
+        :mod:`eulerpoisson.torques` objects, callables ``torque(t, q, omega) ->
+        tau_body``, or a list of them (their sum); None: the free body.
+
+    Raises
+    ------
+    TypeError
+        A torque that is neither a :class:`~eulerpoisson.torques.Torque` nor callable.
+    InvalidInputError
+        Parameter batch shapes that do not broadcast with the body's.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> top = ep.Model([2.0, 2.0, 1.0], ep.torques.Gravity(1.0, [0.0, 0.0, 0.5]))
+    >>> top.is_free, top.lagrange_top() is not None
+    (False, True)
+    """
+
+    def __init__(self, body, torque=None):
+        if isinstance(body, Model):
+            raise TypeError("body is already a Model; pass its body and torques, or the Model itself to solve()")
+        if not isinstance(body, RigidBody):
+            if isinstance(body, (str, bytes)) or body is None:
+                raise TypeError(f"body must be a RigidBody or an inertia array, got {body!r}")
+            body = RigidBody(body)
+        self.body = body
+        self.torques: tuple[Torque, ...] = as_torques(torque)
+        shapes = [body.batch_shape] + [tq.batch_shape for tq in self.torques]
+        try:
+            self.batch_shape = np.broadcast_shapes(*shapes)
+        except ValueError:
+            desc = ", ".join(f"{type(t).__name__} {t.batch_shape}" for t in self.torques)
+            raise InvalidInputError(
+                f"the batch shapes of the body {body.batch_shape} and of the torque parameters ({desc}) do not broadcast"
+            ) from None
+
+    # ------------------------------------------------------------------
+    @property
+    def is_free(self) -> bool:
+        """No torque: the free rigid body (every free-body shortcut applies)."""
+        return not self.torques
+
+    @property
+    def is_conservative(self) -> bool:
+        """Every torque derives from a potential."""
+        return all(t.conservative for t in self.torques)
+
+    @property
+    def is_autonomous(self) -> bool:
+        return not any(t.time_dependent for t in self.torques)
+
+    def describe(self) -> str:
+        """A one-line description (``"free body"``, ``"Gravity(...) + BodyTorque(...)"``)."""
+        return "free body" if self.is_free else " + ".join(repr(t) for t in self.torques)
+
+    def to_records(self) -> list[dict]:
+        """The torques as JSON-able records (:func:`~eulerpoisson.torques.torque_from_dict` reads them)."""
+        return [t.to_dict() for t in self.torques]
+
+    def __repr__(self) -> str:
+        return f"Model({self.body!r}, torque={list(self.torques)!r})"
+
+    def element(self, index: tuple[int, ...]) -> "Model":
+        """The model of one element of a batch: ``index`` is a full index into a batch shape that this
+        model's batch shape broadcasts to (numpy's right-aligned broadcasting rules)."""
+        index = tuple(int(i) for i in index)
+
+        def sub(shape):
+            k = len(shape)
+            tail = index[len(index) - k:] if k else ()
+            return tuple(0 if n == 1 else i for i, n in zip(tail, shape))
+
+        body = self.body[sub(self.body.batch_shape)] if self.body.batch_shape else self.body
+        return Model(body, [t[sub(t.batch_shape)] if t.batch_shape else t for t in self.torques])
+
+    # ------------------------------------------------------------------
+    # the vector field
+    # ------------------------------------------------------------------
+    def torque(self, t, q, omega) -> np.ndarray:
+        r"""Total body-frame torque :math:`\boldsymbol\tau(t, q, \boldsymbol\Omega)`, shape (..., 3).
+
+        Parameters
+        ----------
+        t : float or ndarray, shape (...)
+        q : ndarray, shape (..., 4)
+            Unit quaternions (scalar first).
+        omega : ndarray, shape (..., 3)
+        """
+        omega = np.asarray(omega, dtype=float)
+        out = np.zeros(np.broadcast_shapes(omega.shape, np.shape(q)[:-1] + (3,)))
+        if not self.torques:
+            return out
+        q = np.asarray(q, dtype=float)
+        R = _matrix(q)
+        inertia = self.body.inertia
+        for tq in self.torques:
+            if tq.kind == "callable":
+                out = out + tq.evaluate(t, R, omega, inertia, q=q)
+            else:
+                out = out + tq.evaluate(t, R, omega, inertia)
+        return out
+
+    def omega_dot(self, t, q, omega) -> np.ndarray:
+        r""":math:`\dot{\boldsymbol\Omega} = I^{-1}\big((I\boldsymbol\Omega)\times\boldsymbol\Omega + \boldsymbol\tau\big)`, shape (..., 3)."""
+        omega = np.asarray(omega, dtype=float)
+        M = _mv(self.body.inertia, omega)
+        rhs = np.cross(M, omega)
+        if self.torques:
+            rhs = rhs + self.torque(t, q, omega)
+        return _mv(self.body.inertia_inv, rhs)
+
+    def rhs(self, t, q, omega) -> tuple[np.ndarray, np.ndarray]:
+        r"""The vector field :math:`(\dot q, \dot{\boldsymbol\Omega})`.
+
+        Parameters
+        ----------
+        t : float or ndarray, shape (...)
+        q : ndarray, shape (..., 4)
+        omega : ndarray, shape (..., 3)
+
+        Returns
+        -------
+        qdot : ndarray, shape (..., 4)
+            :math:`\tfrac12 q\otimes(0, \boldsymbol\Omega)`.
+        omega_dot : ndarray, shape (..., 3)
+
+        References
+        ----------
+        Paper eq. 1.4 (in quaternions) and 1.5.
+        """
+        q = np.asarray(q, dtype=float)
+        omega = np.asarray(omega, dtype=float)
+        zero = np.zeros_like(omega[..., 0])
+        qd = 0.5 * np.stack(qmul_components(q[..., 0], q[..., 1], q[..., 2], q[..., 3],
+                                            zero, omega[..., 0], omega[..., 1], omega[..., 2]), -1)
+        return qd, self.omega_dot(t, q, omega)
+
+    def polynomial(self) -> PolynomialTorque | None:
+        """The sum of the torques as a :class:`~eulerpoisson.torques.PolynomialTorque`, or None if one is not polynomial."""
+        total = PolynomialTorque.zero()
+        for tq in self.torques:
+            p = tq.polynomial()
+            if p is None:
+                return None
+            total = total + p
+        return total
+
+    # ------------------------------------------------------------------
+    # energy and integrals
+    # ------------------------------------------------------------------
+    def potential(self, t, q) -> np.ndarray:
+        r"""Sum of the potentials :math:`U(t, R)` of the conservative torques, shape (...).
+
+        Torques without a potential contribute nothing (see :attr:`is_conservative`).
+        """
+        q = np.asarray(q, dtype=float)
+        U = np.zeros(q.shape[:-1])
+        if not self.torques:
+            return U
+        R = _matrix(q)
+        for tq in self.torques:
+            if tq.conservative:
+                U = U + tq.potential(t, R, self.body.inertia)
+        return U
+
+    def energy(self, t, q, omega) -> np.ndarray:
+        r"""Kinetic plus potential energy :math:`\tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega + U`, shape (...)."""
+        omega = np.asarray(omega, dtype=float)
+        E = 0.5 * _dot(omega, _mv(self.body.inertia, omega))
+        return E + self.potential(t, q) if self.torques else E
+
+    def _gravity_direction(self):
+        """Common unit direction of g of the model's Gravity torques, or None."""
+        gs = [t for t in self.torques if isinstance(t, Gravity)]
+        if not gs:
+            return None
+        g = gs[0].g
+        n = np.sqrt(_dot(g, g))
+        if np.any(n == 0):
+            return None
+        ghat = g / n[..., None]
+        for other in gs[1:]:
+            n2 = np.sqrt(_dot(other.g, other.g))
+            if np.any(n2 == 0) or not np.allclose(other.g / n2[..., None], ghat, rtol=0, atol=1e-14):
+                return None
+        return ghat
+
+    def _equatorial_top(self, ratio):
+        r"""``(frame, x0y0, kappa)`` when the model is a heavy top with :math:`I = \mathrm{diag}(r, r, 1)I_3` and c in the equatorial plane."""
+        gs = [t for t in self.torques if isinstance(t, Gravity)]
+        if len(gs) != 1 or len(self.torques) != 1 or self.batch_shape:
+            return None
+        grav = gs[0]
+        ev = self.body.principal_moments
+        P = self.body.principal_axes
+        order = np.argsort(ev)
+        small, a, b = ev[order[0]], ev[order[1]], ev[order[2]]
+        if not (abs(a - b) <= SYMMETRY_RTOL * b and abs(a - ratio * small) <= 1e-12 * a):
+            return None
+        e3 = P[:, order[0]]
+        e1 = P[:, order[1]]
+        e2 = np.cross(e3, e1)
+        F = np.stack([e1, e2, e3], axis=1)  # body = F @ frame
+        c = F.T @ grav.center_of_mass
+        if abs(c[2]) > SYMMETRY_RTOL * max(np.linalg.norm(c), 1e-300) or np.linalg.norm(c) == 0:
+            return None
+        gn = float(np.linalg.norm(grav.g))
+        kappa = float(grav.mass) * gn / float(small)
+        return F, c[:2], kappa, grav.g / gn
+
+    def lagrange_top(self) -> LagrangeTop | None:
+        r"""The model as a :class:`LagrangeTop` (symmetric body, centre of mass on the axis, one Gravity), else None.
+
+        A spherical body (three equal moments) with its centre of mass off
+        the origin is a Lagrange top about the axis through the centre of
+        mass; a centre of mass at the origin is a free body under no torque
+        (not reported here).
+        """
+        if len(self.torques) != 1 or not isinstance(self.torques[0], Gravity) or self.batch_shape:
+            return None
+        grav = self.torques[0]
+        c = grav.center_of_mass
+        cn = float(np.linalg.norm(c))
+        if cn == 0.0:
+            return None
+        ev = self.body.principal_moments
+        P = self.body.principal_axes
+        scale = float(np.max(ev))
+        chat = c / cn
+        Ic = self.body.inertia @ chat
+        # the centre of mass must lie on an eigenvector whose eigenvalue is simple or the body a sphere,
+        # and the other two moments must be equal
+        C = float(chat @ Ic)
+        if np.linalg.norm(Ic - C * chat) > SYMMETRY_RTOL * scale:
+            return None
+        others = np.sort(ev)
+        # remove the eigenvalue C once, the remaining two must be equal
+        k = int(np.argmin(np.abs(ev - C)))
+        rest = np.delete(ev, k)
+        if abs(rest[0] - rest[1]) > SYMMETRY_RTOL * scale:
+            return None
+        A = float(0.5 * (rest[0] + rest[1]))
+        # frame: e3 = chat, e1 any unit vector perpendicular to it
+        trial = P[:, int(np.argmax(np.abs(ev - C)))] if np.ptp(others) > SYMMETRY_RTOL * scale else np.eye(3)[int(np.argmin(np.abs(chat)))]
+        e1 = trial - (trial @ chat) * chat
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(chat, e1)
+        F = np.stack([e1, e2, chat], axis=1)
+        return LagrangeTop(A=np.asarray(A), C=np.asarray(C), mass=np.asarray(grav.mass, float), ell=np.asarray(cn),
+                           g=np.asarray(grav.g, float), frame=F)
+
+    def integrals(self, t, q, omega) -> dict[str, np.ndarray]:
+        r"""The conserved quantities of the model along a trajectory.
+
+        Parameters
+        ----------
+        t : ndarray, shape (T,)
+        q : ndarray, shape (*batch, T, 4)
+            Unit quaternions; the model's batch shape broadcasts to ``batch``.
+        omega : ndarray, shape (*batch, T, 3)
+
+        Returns
+        -------
+        dict of str to ndarray, shape (*batch, T)
+            Free body: ``energy``, ``m_x``, ``m_y``, ``m_z`` (spatial angular
+            momentum) and ``m_norm``. Heavy top (gravity along one direction):
+            ``energy`` and ``m_vertical`` (:math:`\mathbf m\cdot\hat{\mathbf g}`),
+            plus, for one body, ``M3`` (:math:`\mathbf M\cdot\mathbf e_3` about the
+            symmetry axis) for a Lagrange top, ``kovalevskaya`` for
+            :math:`I = \mathrm{diag}(2,2,1)I_3` with the centre of mass in the
+            equatorial plane,
+
+            .. math:: K = \big|(\Omega_1 + i\Omega_2)^2 - \kappa(c_1 + ic_2)(\gamma_1 + i\gamma_2)\big|^2,
+
+            and ``goryachev_chaplygin`` for :math:`\mathrm{diag}(4,4,1)I_3`,
+            :math:`G = \Omega_3(\Omega_1^2 + \Omega_2^2) - \kappa\gamma_3(c_1\Omega_1 + c_2\Omega_2)`,
+            reported only where its level :math:`\mathbf m\cdot\hat{\mathbf g} = 0` holds at the
+            first state (:math:`\kappa = \mu|\mathbf g|/I_3`,
+            :math:`\boldsymbol\gamma = -R^T\hat{\mathbf g}`, components in the frame of
+            the symmetry axis). Gravity gradient alone: ``jacobi``,
+            :math:`J = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega
+            - \nu\,\hat{\mathbf e}_z\cdot\mathbf m + \tfrac32\nu^2\mathbf r\cdot I\mathbf r`.
+            Constant space-frame torques alone: the components of
+            :math:`\mathbf m - \boldsymbol\tau_s t`. Other models: what holds for
+            them (possibly nothing).
+
+        References
+        ----------
+        Borisov and Mamaev (2018), §2.2-2.3; Kovalevskaya (1889); Goryachev (1900),
+        Chaplygin (1901); Beletsky (1966), ch. 1 (the Jacobi integral).
+        """
+        from .torques import SpaceTorque
+
+        t = np.asarray(t, dtype=float)
+        q = np.asarray(q, dtype=float)
+        omega = np.asarray(omega, dtype=float)
+
+        def per_body(a, tail):
+            a = np.asarray(a, dtype=float)
+            return a.reshape(a.shape[: a.ndim - tail] + (1,) + a.shape[a.ndim - tail:])
+
+        inertia = per_body(self.body.inertia, 2)
+        R = _matrix(q)
+        M = _mv(inertia, omega)
+        m = _mv(R, M)
+        kinetic = 0.5 * _dot(omega, M)
+        out: dict[str, np.ndarray] = {}
+        if self.is_free:
+            out["energy"] = kinetic
+            out["m_x"], out["m_y"], out["m_z"] = m[..., 0], m[..., 1], m[..., 2]
+            out["m_norm"] = np.sqrt(_dot(m, m))
+            return out
+        kinds = {type(tq) for tq in self.torques}
+        if kinds == {Gravity}:
+            U = 0.0
+            for tq in self.torques:
+                U = U - _dot(per_body(tq.g, 1), _mv(R, per_body(tq.moment_arm, 1)))
+            out["energy"] = kinetic + U
+            ghat = self._gravity_direction()
+            if ghat is None:
+                return out
+            out["m_vertical"] = _dot(m, per_body(ghat, 1))
+            if self.batch_shape:
+                return out
+            lt = self.lagrange_top()
+            if lt is not None:
+                out["M3"] = _dot(M, lt.frame[:, 2])
+            for ratio, key in ((2.0, "kovalevskaya"), (4.0, "goryachev_chaplygin")):
+                eq = self._equatorial_top(ratio)
+                if eq is None:
+                    continue
+                F, c2, kappa, gh1 = eq
+                w = _mv(F.T, omega)
+                gamma = -_mv(F.T, np.einsum("...ji,j->...i", R, gh1))
+                if key == "kovalevskaya":
+                    val = (w[..., 0] + 1j * w[..., 1]) ** 2 - kappa * (c2[0] + 1j * c2[1]) * (gamma[..., 0] + 1j * gamma[..., 1])
+                    out[key] = (val * np.conj(val)).real
+                else:
+                    area = out["m_vertical"]
+                    scale = float(np.sqrt(np.max(_dot(m, m)))) if m.size else 0.0
+                    if area.size and np.all(np.abs(area[..., 0]) <= 1e-12 * max(scale, 1e-300)):
+                        out[key] = (w[..., 2] * (w[..., 0] ** 2 + w[..., 1] ** 2)
+                                    - kappa * gamma[..., 2] * (c2[0] * w[..., 0] + c2[1] * w[..., 1]))
+            return out
+        if kinds == {GravityGradient} and len(self.torques) == 1:
+            nu = per_body(self.torques[0].mean_motion, 0)
+            phase = t * nu
+            rhat = np.stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)], -1)
+            r = np.einsum("...ji,...j->...i", R, rhat)
+            out["jacobi"] = kinetic - nu * m[..., 2] + 1.5 * nu**2 * _dot(r, _mv(inertia, r))
+            return out
+        if kinds == {SpaceTorque}:
+            tau = sum(per_body(tq.tau, 1) for tq in self.torques)
+            rest = m - t[:, None] * tau
+            for i, ax in enumerate("xyz"):
+                out[f"m_{ax} - tau_{ax} t"] = rest[..., i]
+        return out
+
+
+def as_model(body, torque=None) -> Model:
+    """A :class:`Model` from ``body`` (a Model, a RigidBody or an inertia array) and ``torque``.
+
+    Raises
+    ------
+    TypeError
+        A Model together with a separate ``torque``.
+    """
+    if isinstance(body, Model):
+        if torque is not None:
+            raise TypeError("give the torque either in the Model or as torque=, not both")
+        return body
+    return Model(body, torque)

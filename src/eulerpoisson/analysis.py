@@ -1,4 +1,9 @@
-r"""Quantities of the free motion in closed form: elliptic modulus, periods, flips.
+r"""Quantities of the motion in closed form: elliptic modulus, periods, flips; stability of tops and satellites.
+
+Free body: the elliptic parameters, periods and the tennis-racket flips.
+Under torque: the sleeping top's stability threshold and its small-oscillation
+frequencies (:func:`sleeping_top`), and the small oscillations of a satellite
+about its gravity-gradient equilibrium (:func:`gravity_gradient_frequencies`).
 
 For principal moments :math:`I_1<I_2<I_3`, body angular momentum
 :math:`\mathbf M`, :math:`L^2 = |\mathbf M|^2` and :math:`2E = \mathbf M\cdot I^{-1}\mathbf M`,
@@ -26,7 +31,14 @@ from .util.validate import as_bool, as_float_array
 from .model.body import check_moments
 from .errors import InvalidInputError
 
-__all__ = ["elliptic_parameters", "momentum_period", "tennis_racket_half_period", "flip_times"]
+__all__ = [
+    "elliptic_parameters",
+    "momentum_period",
+    "tennis_racket_half_period",
+    "flip_times",
+    "sleeping_top",
+    "gravity_gradient_frequencies",
+]
 
 
 def elliptic_parameters(inertia, M0) -> dict:
@@ -243,3 +255,145 @@ def flip_times(traj, component: int = 1, *, refine: bool = True) -> np.ndarray:
         if done:
             break
     return x
+
+
+def _positive(x, name):
+    v = as_float_array(x, name)
+    if v.ndim or not v > 0:
+        raise InvalidInputError(f"{name} must be a number > 0, got {x!r}")
+    return float(v)
+
+
+def sleeping_top(I1, I3, mass, ell, spin, g=9.81) -> dict:
+    r"""Stability of a sleeping top (Maxwell–Routh) and its small oscillations.
+
+    A symmetric top (moments :math:`I_1 = I_2`, :math:`I_3` about the fixed
+    point) spins with :math:`\Omega_3` = ``spin`` about its symmetry axis held
+    vertical, the centre of mass at height :math:`\ell` above the fixed point
+    (:math:`\ell < 0`: below it, a hanging top). Linearizing the Euler–Poisson
+    equations about this motion, the axis tip :math:`x + iy` moves as
+    :math:`ae^{i\omega_+t} + be^{i\omega_-t}` with
+
+    .. math:: \omega_\pm = \frac{I_3\Omega_3 \pm \sqrt{I_3^2\Omega_3^2 - 4\mu g\ell I_1}}{2I_1},
+
+    so the top is stable while :math:`I_3^2\Omega_3^2 > 4\mu g\ell I_1`
+    (Maxwell–Routh; always for :math:`\ell \le 0`), and the tilt of a
+    slightly disturbed top nutates with the frequency :math:`\omega_+ - \omega_-`.
+
+    Parameters
+    ----------
+    I1, I3 : float
+        Transverse and axial moments about the fixed point, > 0.
+    mass : float
+        > 0.
+    ell : float
+        Height of the centre of mass above the fixed point along the axis (any sign).
+    spin : float
+        :math:`\Omega_3`, any sign.
+    g : float
+        Magnitude of gravity, > 0 (default 9.81).
+
+    Returns
+    -------
+    dict
+        ``stable`` (bool), ``critical_spin`` (the smallest
+        :math:`|\Omega_3|` for stability, :math:`2\sqrt{\mu g\ell I_1}/I_3`,
+        0 for :math:`\ell \le 0`), ``omega_plus``, ``omega_minus`` (the fast
+        and slow precession rates, NaN when unstable), ``nutation_frequency``
+        (:math:`\omega_+ - \omega_-`, NaN when unstable), ``growth_rate``
+        (:math:`\sqrt{4\mu g\ell I_1 - I_3^2\Omega_3^2}/(2I_1)` when
+        unstable, else 0), ``fall_angle`` (unstable: the largest tilt a
+        slightly disturbed top reaches, :math:`\arccos(I_3^2\Omega_3^2/(2\mu g\ell I_1) - 1)`,
+        from the energy and the two momenta of the Lagrange top; 0 when stable).
+
+    Raises
+    ------
+    InvalidInputError
+        Non-positive moments, mass or g; non-finite values.
+
+    References
+    ----------
+    J. C. Maxwell (1857); E. J. Routh, *Advanced Rigid Dynamics* (1905), §207;
+    A. Sommerfeld and F. Klein, *Über die Theorie des Kreisels* (1897); H.
+    Goldstein, *Classical Mechanics*, 3rd ed., §5.7 (the "fast top").
+    """
+    I1 = _positive(I1, "I1")
+    I3 = _positive(I3, "I3")
+    mass = _positive(mass, "mass")
+    g = _positive(g, "g")
+    ell = float(as_float_array(ell, "ell"))
+    spin = float(as_float_array(spin, "spin"))
+    a = I3 * spin
+    disc = a * a - 4.0 * mass * g * ell * I1
+    crit = 2.0 * np.sqrt(mass * g * ell * I1) / I3 if ell > 0 else 0.0
+    if disc > 0 or (ell <= 0 and disc >= 0):
+        r = np.sqrt(disc)
+        return {"stable": True, "critical_spin": crit, "omega_plus": (a + r) / (2 * I1),
+                "omega_minus": (a - r) / (2 * I1), "nutation_frequency": r / I1, "growth_rate": 0.0, "fall_angle": 0.0}
+    return {"stable": False, "critical_spin": crit, "omega_plus": np.nan, "omega_minus": np.nan,
+            "nutation_frequency": np.nan, "growth_rate": float(np.sqrt(-disc) / (2 * I1)),
+            "fall_angle": float(np.arccos(a * a / (2.0 * mass * g * ell * I1) - 1.0))}
+
+
+def gravity_gradient_frequencies(moments, mean_motion) -> dict:
+    r"""Small oscillations of a satellite about its gravity-gradient equilibrium on a circular orbit.
+
+    The principal axes of the satellite are aligned with the orbit frame:
+    ``moments = (I_roll, I_pitch, I_yaw)`` about the along-track direction,
+    the orbit normal and the local vertical (the direction to the body,
+    :math:`\hat{\mathbf r}` of :class:`~eulerpoisson.torques.GravityGradient`);
+    the satellite turns once per orbit about the orbit normal. With
+    :math:`k_1 = (I_p - I_y)/I_r` and :math:`k_3 = (I_p - I_r)/I_y`, the
+    pitch oscillation decouples,
+
+    .. math:: \omega_p^2 = 3\nu^2\,\frac{I_r - I_y}{I_p},
+
+    and roll and yaw are coupled, with :math:`\omega^2` the roots of
+
+    .. math:: \omega^4 - \nu^2(1 + 3k_1 + k_1k_3)\,\omega^2 + 4k_1k_3\nu^4 = 0 .
+
+    The equilibrium is stable (linearly) when all three :math:`\omega^2` are
+    real and positive, e.g. in the Lagrange region :math:`I_p > I_r > I_y`.
+
+    Parameters
+    ----------
+    moments : array_like, shape (3,)
+        :math:`(I_r, I_p, I_y)`, > 0.
+    mean_motion : float
+        :math:`\nu` > 0.
+
+    Returns
+    -------
+    dict
+        ``pitch`` (:math:`\omega_p`), ``roll_yaw`` (the two roll-yaw
+        frequencies, largest first), ``stable`` (bool); frequencies are NaN
+        where the corresponding :math:`\omega^2` is not a positive real.
+
+    Raises
+    ------
+    InvalidInputError
+        Non-positive moments or mean motion, wrong shape.
+
+    References
+    ----------
+    P. C. Hughes, *Spacecraft Attitude Dynamics* (1986), §9.2; V. V. Beletsky,
+    *Motion of an Artificial Satellite about its Center of Mass* (1966), ch. 2.
+    """
+    Im = as_float_array(moments, "moments", (3,))
+    if Im.ndim != 1 or np.any(Im <= 0):
+        raise InvalidInputError(f"moments must be three numbers > 0 (I_roll, I_pitch, I_yaw), got {moments!r}")
+    nu = _positive(mean_motion, "mean_motion")
+    Ir, Ip, Iy = Im
+    wp2 = 3.0 * nu * nu * (Ir - Iy) / Ip
+    k1 = (Ip - Iy) / Ir
+    k3 = (Ip - Ir) / Iy
+    b = 1.0 + 3.0 * k1 + k1 * k3
+    c = 4.0 * k1 * k3
+    disc = b * b - 4.0 * c
+    roots = []
+    if disc >= 0:
+        r = np.sqrt(disc)
+        roots = [0.5 * nu * nu * (b + r), 0.5 * nu * nu * (b - r)]
+    freqs = [float(np.sqrt(x)) if x > 0 else np.nan for x in roots] or [np.nan, np.nan]
+    stable = wp2 > 0 and disc >= 0 and all(x > 0 for x in roots)
+    return {"pitch": float(np.sqrt(wp2)) if wp2 > 0 else np.nan, "roll_yaw": tuple(freqs), "stable": bool(stable)}

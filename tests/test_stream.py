@@ -1,5 +1,6 @@
 """Streaming long solutions to Zarr: values, bounded memory, atomicity, interruption and resume."""
 
+import dataclasses
 import json
 import tracemalloc
 
@@ -11,7 +12,7 @@ xr = pytest.importorskip("xarray")
 
 from eulerpoisson import RigidBody  # noqa: E402
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError  # noqa: E402
-from eulerpoisson.solvers import Method, MethodResult, register_method, solve  # noqa: E402
+from eulerpoisson.solvers import Method, MethodOptions, MethodResult, register_method, solve  # noqa: E402
 from eulerpoisson.solvers.registry import _REGISTRY  # noqa: E402
 from eulerpoisson.io.stream import TIME_VARIABLES, TimeGrid, partial_store, solve_to_file  # noqa: E402
 
@@ -30,11 +31,17 @@ def _qmul(p, q):
                      pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw], -1)
 
 
+@dataclasses.dataclass(frozen=True)
+class _RK4Options(MethodOptions):
+    method = "_test_rk4"
+    dt: float = 0.01
+
+
 class _RK4(Method):
     """Classical RK4 on (q, Omega), output to output with steps <= dt (test-only)."""
 
     name = "_test_rk4"
-    options = {"dt": 0.01}
+    Options = _RK4Options
     order = 4
     refine = "dt"
 

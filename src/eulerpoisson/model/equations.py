@@ -44,34 +44,13 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..numerics.quaternion import qmul_components
 from .body import RigidBody
+from .free_body import euler_coefficients
 from .torques import Gravity, GravityGradient, PolynomialTorque, Torque, as_torques
 
-__all__ = ["Model", "LagrangeTop", "euler_coefficients", "as_model"]
+__all__ = ["Model", "LagrangeTop", "as_model"]
 
 #: relative tolerance for recognizing equal moments and a centre of mass on an axis or plane
 SYMMETRY_RTOL = 1e-12
-
-
-def euler_coefficients(moments):
-    r"""Euler's coefficients :math:`a_i = (I_j - I_k)/I_i` ((i, j, k) cyclic), the one copy.
-
-    Euler's equations in the principal frame read
-    :math:`\dot\Omega_i = a_i\Omega_j\Omega_k`.
-
-    Parameters
-    ----------
-    moments : array_like, shape (3, ...) (component first)
-
-    Returns
-    -------
-    tuple of three arrays
-
-    References
-    ----------
-    Paper eq. 1.5.
-    """
-    I1, I2, I3 = moments[0], moments[1], moments[2]
-    return (I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3
 
 
 def _matrix(q):

@@ -11,15 +11,35 @@ A new method is one new folder here plus its import below.
 """
 
 from .problem import Problem, compose_initial, make_problem
-from .registry import Method, MethodResult, available_methods, get_method, register_method
+from .registry import (
+    Method,
+    MethodOptions,
+    MethodResult,
+    available_methods,
+    check_supported,
+    get_method,
+    methods_supporting,
+    register_method,
+)
 from . import exact, rk, symplectic, taylor  # noqa: F401  (importing registers the methods)
 from .driver import solve
+from .exact.method import ExactOptions
+from .rk.method import RKOptions
+from .symplectic.method import SymplecticOptions
+from .taylor.method import TaylorOptions
 
 __all__ = [
     "Problem",
     "make_problem",
     "compose_initial",
     "Method",
+    "MethodOptions",
+    "ExactOptions",
+    "RKOptions",
+    "SymplecticOptions",
+    "TaylorOptions",
+    "methods_supporting",
+    "check_supported",
     "MethodResult",
     "register_method",
     "available_methods",

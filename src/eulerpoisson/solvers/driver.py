@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..trajectory import Trajectory
 from .problem import make_problem
-from .registry import check_supported, get_method
+from .registry import MethodOptions, check_supported, get_method
 
 __all__ = ["solve"]
 
@@ -50,9 +50,12 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
         ``BodyTorque``, ``SpaceTorque``; a callable ``torque(t, q, omega) ->
         tau_body`` vectorized over the batch; a list is their sum). None: the
         free body. For a heavy top the inertia is about the fixed point.
-    method : str
+    method : str or MethodOptions
         A name from :func:`available_methods`: ``"exact"`` (closed form,
-        default: the free body and the Lagrange top) and the integrators.
+        default: the free body and the Lagrange top) and the integrators; or
+        a method's typed options (``TaylorOptions(tol=1e-12)``,
+        ``SymplecticOptions(scheme="gauss6", dt=0.01)``, ...), which name
+        their method.
     **options
         Method options (e.g. ``tol`` or ``dt``); unknown ones raise TypeError.
 
@@ -84,8 +87,13 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
     >>> tr.omega.shape
     (2, 3)
     """
-    cls = get_method(method)
-    m = cls(**options)
+    if isinstance(method, MethodOptions):
+        cls = get_method(method.method)
+        m = cls(method, **options)
+        method = method.method
+    else:
+        cls = get_method(method)
+        m = cls(**options)
     problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, torque=torque)
     check_supported(method, problem.model)
     if not cls.negative_times and np.any(problem.t < 0):

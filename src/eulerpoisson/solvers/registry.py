@@ -9,7 +9,8 @@ runs any of them and one test can check all of them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import dataclasses
+from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar
 
 import numpy as np
@@ -19,6 +20,7 @@ from ..model.equations import Model
 from .problem import Problem
 
 __all__ = [
+    "MethodOptions",
     "Method",
     "MethodResult",
     "register_method",
@@ -48,19 +50,81 @@ class MethodResult:
     stats: dict = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class MethodOptions:
+    """Base of the typed, frozen option sets of the methods (one dataclass per method).
+
+    Constructing one validates it (``TypeError`` or
+    :class:`~eulerpoisson.errors.InvalidInputError` naming the option), so an
+    options object is always valid; :meth:`replace` makes a validated copy.
+    Pass one as ``solve(..., method=TaylorOptions(tol=1e-12))``: the class
+    knows its method (:attr:`method`).
+    """
+
+    #: name of the method these options belong to
+    method: ClassVar[str] = ""
+
+    def __post_init__(self) -> None:
+        self.check()
+
+    def check(self) -> None:
+        """Validate (and normalize) the fields; override in subclasses."""
+
+    def _update(self, values: dict) -> None:
+        """Store normalized values (used by :meth:`check`; the dataclass is frozen)."""
+        for k, v in values.items():
+            object.__setattr__(self, k, v)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The options as a plain dict (as recorded in trajectories and files)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def names(cls) -> list[str]:
+        """The option names."""
+        return [f.name for f in fields(cls)]
+
+    @classmethod
+    def defaults(cls) -> dict[str, Any]:
+        """The default value of every option."""
+        return {f.name: f.default for f in fields(cls)}
+
+    def replace(self, **changes) -> "MethodOptions":
+        """A validated copy with some options changed.
+
+        Raises
+        ------
+        TypeError
+            An unknown option (the message lists the allowed ones).
+        """
+        _check_names(type(self), changes)
+        return dataclasses.replace(self, **changes)
+
+
+def _check_names(options_cls, given) -> None:
+    unknown = sorted(set(given) - set(options_cls.names()))
+    if unknown:
+        allowed = ", ".join(sorted(options_cls.names())) or "none"
+        raise TypeError(f"method {options_cls.method!r} got unknown option(s) {', '.join(unknown)}; allowed: {allowed}")
+
+
 class Method:
     """Base class of a solution method.
 
-    Subclasses set :attr:`name`, :attr:`options` (allowed keyword options with
-    their defaults) and implement :meth:`run`. Options are validated on
-    construction: an unknown option raises ``TypeError`` naming it.
+    Subclasses set :attr:`name`, :attr:`Options` (a frozen
+    :class:`MethodOptions` dataclass of the options with their defaults and
+    validation) and implement :meth:`run`; :meth:`supports` says which models
+    they can run. Constructed from an ``Options`` instance and/or keyword
+    options: an unknown option raises ``TypeError`` naming it.
 
     Class attributes
     ----------------
     name : str
         Registry key used by ``solve(..., method=name)``.
+    Options : type
+        The options dataclass.
     options : dict
-        Allowed options and defaults.
+        The default of every option (derived from ``Options`` on registration).
     order : int or None
         Nominal order of convergence (None for exact methods).
     refine : str or None
@@ -68,27 +132,42 @@ class Method:
         the registry-driven convergence test.
     negative_times : bool
         Whether the method accepts t < 0 (time reversal).
+
+    Attributes
+    ----------
+    opts : MethodOptions
+        The validated options of this instance.
+    config : dict
+        The same as a dict.
     """
 
     name: ClassVar[str] = ""
+    Options: ClassVar[type[MethodOptions]] = MethodOptions
     options: ClassVar[dict[str, Any]] = {}
     order: ClassVar[int | None] = None
     refine: ClassVar[str | None] = None
     negative_times: ClassVar[bool] = True
     description: ClassVar[str] = ""
 
-    def __init__(self, **options):
-        unknown = sorted(set(options) - set(self.options))
-        if unknown:
-            allowed = ", ".join(sorted(self.options)) or "none"
-            raise TypeError(
-                f"method {self.name!r} got unknown option(s) {', '.join(unknown)}; allowed: {allowed}"
-            )
-        self.config = {**self.options, **options}
-        self.validate()
+    def __init__(self, options: MethodOptions | None = None, /, **kwargs):
+        if options is not None:
+            if not isinstance(options, self.Options):
+                raise TypeError(
+                    f"method {self.name!r} takes options of type {self.Options.__name__}, got {type(options).__name__}"
+                )
+            opts = options.replace(**kwargs) if kwargs else options
+        else:
+            _check_names(self.Options, kwargs)
+            opts = self.Options(**kwargs)
+        self.opts = opts
+        self.config = opts.to_dict()
 
-    def validate(self) -> None:
-        """Check ``self.config``; override to validate option values."""
+    def nominal_order(self) -> int | None:
+        """Nominal order of this configured instance (may depend on options such as ``scheme``)."""
+        return self.order
+
+    def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
+        raise NotImplementedError
 
     @classmethod
     def supports(cls, model: Model) -> str | None:
@@ -112,6 +191,7 @@ def register_method(cls: type[Method]) -> type[Method]:
     """Class decorator: register a :class:`Method` subclass under ``cls.name``."""
     if not cls.name:
         raise ValueError("a registered method needs a name")
+    cls.options = cls.Options.defaults()
     _REGISTRY[cls.name] = cls
     return cls
 

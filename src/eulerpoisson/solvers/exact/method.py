@@ -24,12 +24,14 @@ Comput. 30 (2008) 2084-2112.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ...attitude.core import quaternion_from_rotation_matrix
 from ...numerics.quaternion import qmul
 from ..problem import Problem, compose_initial
-from ..registry import Method, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, register_method
 
 __all__ = ["Exact"]
 
@@ -73,6 +75,13 @@ def _check_phase_range(problem: Problem) -> None:
         )
 
 
+@dataclass(frozen=True)
+class ExactOptions(MethodOptions):
+    """``method="exact"`` has no options."""
+
+    method = "exact"
+
+
 @register_method
 class Exact(Method):
     r"""Closed-form solution by Jacobi elliptic functions and Carlson's integrals.
@@ -89,7 +98,7 @@ class Exact(Method):
     """
 
     name = "exact"
-    options: dict = {}
+    Options = ExactOptions
     order = None
     description = "closed form (Jacobi elliptic functions, elliptic integral of the third kind)"
 

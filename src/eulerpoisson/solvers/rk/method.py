@@ -37,13 +37,17 @@ Equations I*, 2nd ed. (1993), II.5 (DOP853).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import math
 
 import numpy as np
 
 from ...errors import EulerPoissonError, InvalidInputError
+from ...model.free_body import euler_coefficients
 from ..problem import Problem
-from ..registry import Method, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, register_method
 from .. import charts as ch
 
 __all__ = ["RK", "INTEGRATORS"]
@@ -56,10 +60,7 @@ FORMULATIONS = ("quaternion", "gibbs")
 
 def _rhs_quaternion(inv_moments, moments):
     """Right-hand side of (q, Omega) for one body in its principal frame."""
-    I1, I2, I3 = moments
-    a1 = (I2 - I3) / I1
-    a2 = (I3 - I1) / I2
-    a3 = (I1 - I2) / I3
+    a1, a2, a3 = euler_coefficients(*moments)
 
     def f(t, y):
         w, x, yy, z, o1, o2, o3 = y
@@ -80,10 +81,7 @@ def _rhs_quaternion(inv_moments, moments):
 
 def _rhs_gibbs(moments):
     r"""Right-hand side of (n, Omega), eq. 1.30, for one body in its principal frame."""
-    I1, I2, I3 = moments
-    a1 = (I2 - I3) / I1
-    a2 = (I3 - I1) / I2
-    a3 = (I1 - I2) / I3
+    a1, a2, a3 = euler_coefficients(*moments)
 
     def f(t, y):
         n1, n2, n3, o1, o2, o3 = y
@@ -111,6 +109,53 @@ _RTOL_MIN = 100 * np.finfo(float).eps
 
 #: right-hand side evaluations allowed per step of ``max_steps`` (DOP853 uses 12 per step)
 _NFEV_PER_STEP = 16
+
+
+@dataclass(frozen=True)
+class RKOptions(MethodOptions):
+    """Options of ``method="rk"`` (scipy's ``solve_ivp``); see :class:`RK` for their meaning."""
+
+    method: ClassVar[str] = "rk"
+
+    integrator: str = "DOP853"
+    formulation: str = "quaternion"
+    tol: float = 1e-10
+    rtol: float | None = None
+    atol: float | None = None
+    chart_threshold: float = 1.0
+    max_steps: int = 10_000_000
+
+    def check(self) -> None:
+        cfg = self.to_dict()
+        integ = cfg["integrator"]
+        if not isinstance(integ, str) or integ not in INTEGRATORS:
+            raise InvalidInputError(
+                f"rk: unknown integrator {integ!r}; choose one of scipy's solve_ivp methods "
+                f"{', '.join(INTEGRATORS)}"
+            )
+        form = cfg["formulation"]
+        if not isinstance(form, str) or form not in FORMULATIONS:
+            raise InvalidInputError(f"rk: unknown formulation {form!r}; choose one of {', '.join(FORMULATIONS)}")
+        for key in ("tol", "rtol", "atol"):
+            v = cfg[key]
+            if v is None and key != "tol":
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise InvalidInputError(f"rk: {key} must be a positive number, got {v!r}")
+            if not (math.isfinite(float(v)) and float(v) > 0):
+                raise InvalidInputError(f"rk: {key} must be a finite number > 0, got {v!r}")
+            if key != "atol" and not (_RTOL_MIN <= float(v) < 1.0):
+                raise InvalidInputError(
+                    f"rk: {key} must be in [{_RTOL_MIN:.3g}, 1) (scipy's solve_ivp raises a smaller relative "
+                    f"tolerance to 100 machine epsilons), got {v!r}"
+                )
+        thr = ch.check_threshold(cfg["chart_threshold"])
+        if thr == 0:
+            raise InvalidInputError("rk: chart_threshold must be > 0 (the chart event is |n| = chart_threshold)")
+        cfg["chart_threshold"] = thr
+        cfg["max_steps"] = ch.check_count("rk", "max_steps", cfg["max_steps"])
+
+        self._update(cfg)
 
 
 @register_method
@@ -144,49 +189,11 @@ class RK(Method):
     """
 
     name = "rk"
-    options = {
-        "integrator": "DOP853",
-        "formulation": "quaternion",
-        "tol": 1e-10,
-        "rtol": None,
-        "atol": None,
-        "chart_threshold": ch.DEFAULT_CHART_THRESHOLD,
-        "max_steps": 10_000_000,
-    }
+    Options = RKOptions
     order = 8
     refine = "tol"
     negative_times = True
     description = "scipy solve_ivp (DOP853 by default) on (q, Omega) or (n, Omega) with charts"
-
-    def validate(self) -> None:
-        cfg = self.config
-        integ = cfg["integrator"]
-        if not isinstance(integ, str) or integ not in INTEGRATORS:
-            raise InvalidInputError(
-                f"rk: unknown integrator {integ!r}; choose one of scipy's solve_ivp methods "
-                f"{', '.join(INTEGRATORS)}"
-            )
-        form = cfg["formulation"]
-        if not isinstance(form, str) or form not in FORMULATIONS:
-            raise InvalidInputError(f"rk: unknown formulation {form!r}; choose one of {', '.join(FORMULATIONS)}")
-        for key in ("tol", "rtol", "atol"):
-            v = cfg[key]
-            if v is None and key != "tol":
-                continue
-            if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise InvalidInputError(f"rk: {key} must be a positive number, got {v!r}")
-            if not (math.isfinite(float(v)) and float(v) > 0):
-                raise InvalidInputError(f"rk: {key} must be a finite number > 0, got {v!r}")
-            if key != "atol" and not (_RTOL_MIN <= float(v) < 1.0):
-                raise InvalidInputError(
-                    f"rk: {key} must be in [{_RTOL_MIN:.3g}, 1) (scipy's solve_ivp raises a smaller relative "
-                    f"tolerance to 100 machine epsilons), got {v!r}"
-                )
-        thr = ch.check_threshold(cfg["chart_threshold"])
-        if thr == 0:
-            raise InvalidInputError("rk: chart_threshold must be > 0 (the chart event is |n| = chart_threshold)")
-        cfg["chart_threshold"] = thr
-        cfg["max_steps"] = ch.check_count("rk", "max_steps", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of the configured scipy integrator."""

@@ -92,6 +92,8 @@ integrators", Phys. Lett. A 150 (1990) 262.
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import math
 from dataclasses import dataclass
 
@@ -102,7 +104,7 @@ from ...errors import EulerPoissonError, InvalidInputError, UnsupportedModelErro
 from ...numerics.quaternion import qmul
 from ...util.jit import USE_NUMBA
 from ..problem import Problem
-from ..registry import Method, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, register_method
 from .. import charts as ch
 
 __all__ = ["Symplectic", "GaussTableau", "gauss_tableau", "gauss_step", "splitting_sequence", "splitting_advance"]
@@ -458,6 +460,43 @@ def splitting_advance(q, M, inv_moments, h, nsteps, sequence):
 # ---------------------------------------------------------------------------
 # the registered method
 # ---------------------------------------------------------------------------
+@dataclass(frozen=True)
+class SymplecticOptions(MethodOptions):
+    """Options of ``method="symplectic"``; see :class:`Symplectic` for their meaning."""
+
+    method: ClassVar[str] = "symplectic"
+
+    scheme: str | None = None
+    variables: str = "quaternion"
+    dt: float | None = None
+    max_iter: int = 100
+    chart_threshold: float = 1.0
+    max_steps: int = 100_000_000
+
+    def check(self) -> None:
+        cfg = self.to_dict()
+        scheme = cfg["scheme"]
+        if scheme is not None and (not isinstance(scheme, str) or scheme not in SCHEMES):
+            raise InvalidInputError(
+                f"symplectic: unknown scheme {scheme!r}; choose one of {', '.join(SCHEMES)}"
+            )
+        if cfg["variables"] not in VARIABLES:
+            raise InvalidInputError(
+                f"symplectic: unknown variables {cfg['variables']!r}; choose one of {', '.join(VARIABLES)}"
+            )
+        dt = cfg["dt"]
+        if dt is not None:
+            if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)):
+                raise InvalidInputError(f"symplectic: dt must be a positive number or None, got {dt!r}")
+            if not (math.isfinite(float(dt)) and float(dt) > 0):
+                raise InvalidInputError(f"symplectic: dt must be a finite number > 0, got {dt!r}")
+        cfg["max_iter"] = ch.check_count("symplectic", "max_iter", cfg["max_iter"])
+        cfg["chart_threshold"] = ch.check_threshold(cfg["chart_threshold"])
+        cfg["max_steps"] = ch.check_count("symplectic", "max_steps", cfg["max_steps"])
+
+        self._update(cfg)
+
+
 @register_method
 class Symplectic(Method):
     r"""Symplectic integrators: Gauss collocation in :math:`(\mathbf n,\boldsymbol\pi)` or Lie-Poisson splitting.
@@ -509,39 +548,11 @@ class Symplectic(Method):
     """
 
     name = "symplectic"
-    options = {
-        "scheme": None,
-        "variables": "quaternion",
-        "dt": None,
-        "max_iter": 100,
-        "chart_threshold": ch.DEFAULT_CHART_THRESHOLD,
-        "max_steps": 100_000_000,
-    }
+    Options = SymplecticOptions
     order = 4
     refine = "dt"
     negative_times = True
     description = "Gauss-Legendre collocation in (n, pi) with chart changes, or Lie-Poisson splitting in (R, M)"
-
-    def validate(self) -> None:
-        cfg = self.config
-        scheme = cfg["scheme"]
-        if scheme is not None and (not isinstance(scheme, str) or scheme not in SCHEMES):
-            raise InvalidInputError(
-                f"symplectic: unknown scheme {scheme!r}; choose one of {', '.join(SCHEMES)}"
-            )
-        if cfg["variables"] not in VARIABLES:
-            raise InvalidInputError(
-                f"symplectic: unknown variables {cfg['variables']!r}; choose one of {', '.join(VARIABLES)}"
-            )
-        dt = cfg["dt"]
-        if dt is not None:
-            if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)):
-                raise InvalidInputError(f"symplectic: dt must be a positive number or None, got {dt!r}")
-            if not (math.isfinite(float(dt)) and float(dt) > 0):
-                raise InvalidInputError(f"symplectic: dt must be a finite number > 0, got {dt!r}")
-        cfg["max_iter"] = ch.check_count("symplectic", "max_iter", cfg["max_iter"])
-        cfg["chart_threshold"] = ch.check_threshold(cfg["chart_threshold"])
-        cfg["max_steps"] = ch.check_count("symplectic", "max_steps", cfg["max_steps"])
 
     def nominal_order(self) -> int:
         """Order of convergence of the configured scheme (2, 4 or 6; 4 for the default)."""

@@ -96,6 +96,7 @@ STATUS_MAX_STEPS = 1
 STATUS_NONFINITE = 2
 
 
+from ...model.free_body import euler_coefficients
 from ...numerics.doubledouble import two_sum
 from ...numerics.quaternion import qmul_components
 from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
@@ -389,7 +390,7 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
     B = moments.shape[0]
     T = t.shape[0]
     I1, I2, I3 = moments[:, 0], moments[:, 1], moments[:, 2]
-    a = np.stack([(I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3]).astype(dtype)
+    a = np.stack(euler_coefficients(I1, I2, I3)).astype(dtype)
     q_out = np.zeros((B, T, 4), dtype=dtype)
     w_out = np.zeros((B, T, 3), dtype=dtype)
     stats = np.zeros((B, 3), dtype=np.int64)
@@ -566,7 +567,8 @@ def _nb_coefficients(moments, n0, w0, order):
         I1 = moments[b, 0]
         I2 = moments[b, 1]
         I3 = moments[b, 2]
-        _nb_series((I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3, n0[b], w0[b], order, N[b], W[b], S)
+        a0, a1, a2 = euler_coefficients(I1, I2, I3)
+        _nb_series(a0, a1, a2, n0[b], w0[b], order, N[b], W[b], S)
     return N, W
 
 
@@ -665,9 +667,7 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
         I1 = moments[b, 0]
         I2 = moments[b, 1]
         I3 = moments[b, 2]
-        a0 = (I2 - I3) / I1
-        a1 = (I3 - I1) / I2
-        a2 = (I1 - I2) / I3
+        a0, a1, a2 = euler_coefficients(I1, I2, I3)
         scale_w = max(abs(w0[b, 0]), abs(w0[b, 1]), abs(w0[b, 2]))
         steps = 0
         charts = 0
@@ -1019,9 +1019,7 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
                     I1 = moments[b, 0]
                     I2 = moments[b, 1]
                     I3 = moments[b, 2]
-                    lane_a[l] = (I2 - I3) / I1
-                    lane_a[_TL + l] = (I3 - I1) / I2
-                    lane_a[2 * _TL + l] = (I1 - I2) / I3
+                    lane_a[l], lane_a[_TL + l], lane_a[2 * _TL + l] = euler_coefficients(I1, I2, I3)
                     scale_w[l] = max(abs(w0[b, 0]), abs(w0[b, 1]), abs(w0[b, 2]))
                 else:
                     need[l] = 0

@@ -84,16 +84,20 @@ Anwendungen* (1960). A. Griewank and A. Walther, *Evaluating Derivatives*,
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import ClassVar
+
 import numbers
 
 import numpy as np
 
 from ...util.validate import as_float_array, as_scalar
 from ...attitude.core import quaternion_from_rotation_matrix
+from ...model.free_body import euler_coefficients
 from ...numerics.quaternion import qmul
 from ...errors import EulerPoissonError, InvalidInputError
 from ..problem import Problem
-from ..registry import Method, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, register_method
 from . import kernels as _k
 
 __all__ = [
@@ -173,7 +177,7 @@ def _inertia_parts(inertia):
 
 def _euler_coefficients(m):
     I1, I2, I3 = m[0], m[1], m[2]
-    return np.stack([(I2 - I3) / I1, (I3 - I1) / I2, (I1 - I2) / I3])
+    return np.stack(euler_coefficients(I1, I2, I3))
 
 
 def _check_series_order(order) -> int:
@@ -457,6 +461,30 @@ def integrate_principal(
     return q, om, stats
 
 
+@dataclass(frozen=True)
+class TaylorOptions(MethodOptions):
+    """Options of ``method="taylor"``; see :class:`Taylor` for their meaning."""
+
+    method: ClassVar[str] = "taylor"
+
+    tol: float = 1e-15
+    order: int | None = None
+    dt: float | None = None
+    max_steps: int = 1_000_000
+    chart_threshold: float = 1.0
+
+    def check(self) -> None:
+        c = cfg = self.to_dict()
+        if c["dt"] is not None:
+            as_scalar(c["dt"], "dt", positive=True)
+        if c["order"] is not None:
+            _check_order(c["order"], adaptive=c["dt"] is None)
+        _check_tol(c["tol"], np.float64)
+        as_scalar(c["max_steps"], "max_steps", positive=True, integer=True)
+        as_scalar(c["chart_threshold"], "chart_threshold", nonnegative=True)
+        self._update(cfg)
+
+
 @register_method
 class Taylor(Method):
     r"""The Lie series (paper eq. 1.23.1) as an arbitrary-order Taylor integrator.
@@ -525,21 +553,11 @@ class Taylor(Method):
     """
 
     name = "taylor"
-    options = {"tol": 1e-15, "order": None, "dt": None, "max_steps": 1_000_000, "chart_threshold": 1.0}
+    Options = TaylorOptions
     order = DEFAULT_FIXED_ORDER
     refine = "dt"
     negative_times = True
     description = "Lie series (eq. 1.23.1) as an adaptive high-order Taylor integrator"
-
-    def validate(self) -> None:
-        c = self.config
-        if c["dt"] is not None:
-            as_scalar(c["dt"], "dt", positive=True)
-        if c["order"] is not None:
-            _check_order(c["order"], adaptive=c["dt"] is None)
-        _check_tol(c["tol"], np.float64)
-        as_scalar(c["max_steps"], "max_steps", positive=True, integer=True)
-        as_scalar(c["chart_threshold"], "chart_threshold", nonnegative=True)
 
     @classmethod
     def supports(cls, model) -> str | None:

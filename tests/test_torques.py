@@ -330,3 +330,37 @@ def test_compose_initial_refuses_models_with_torque():
     p = make_problem([1, 2, 3], [1.0], omega0=[1, 0, 0], torque=BodyTorque([1, 0, 0]))
     with pytest.raises(ValueError, match="free-body shortcut"):
         compose_initial(p, np.zeros((1, 4)))
+
+
+def test_exact_lagrange_top_in_any_body_frame_agrees_with_reference_at_t10():
+    """The symmetry axis along a rotated direction of a full tensor: recognized, solved in closed form."""
+    R0 = ep.Attitude.from_rotvec([0.3, -0.5, 0.2]).as_matrix()
+    inertia = R0 @ np.diag([0.5, 1.0, 1.0]) @ R0.T
+    c = R0 @ np.array([0.12, 0.0, 0.0])
+    w0 = R0 @ np.array([15.0, 0.3, -0.2])
+    qr, wr = reference_motion(inertia, Q0, w0, [10.0], **_gravity_ref(1.0, c))
+    model = ep.Model(inertia, Gravity(1.0, c))
+    assert model.lagrange_top() is not None
+    tr = ep.solve(model, [0.0, 10.0], omega0=w0, attitude0=Q0, method="exact")
+    dq, dw = _errors(tr, qr, wr)
+    assert dq <= 1e-12 and dw <= 1e-12, (dq, dw)
+    assert tr.stats["model"] == "lagrange top"
+    inertia, q0, w0, torque, _ = CASES["lagrange"]
+    qr, wr = _reference("lagrange")
+    tr = ep.solve(inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="exact")
+    dq, dw = _errors(tr, qr, wr)
+    assert dq <= 1e-12 and dw <= 1e-12, (dq, dw)
+
+
+def test_exact_lagrange_batches_equal_one_by_one_and_other_tops_are_refused():
+    masses = np.array([0.5, 1.0, 2.0])
+    t = np.linspace(-2, 5, 8)
+    batch = ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(masses, [0, 0, 0.1]), method="exact")
+    for b in range(3):
+        one = ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(masses[b], [0, 0, 0.1]),
+                       method="exact")
+        np.testing.assert_allclose(batch.quaternion[b], one.quaternion, atol=1e-15)
+    with pytest.raises(UnsupportedModelError, match="Lagrange top.*methods that can: rk, symplectic, taylor"):
+        ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(1.0, [0.1, 0, 0.1]), method="exact")
+    with pytest.raises(UnsupportedModelError, match="Lagrange top"):
+        ep.solve([1.0, 1.2, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(1.0, [0, 0, 0.1]), method="exact")

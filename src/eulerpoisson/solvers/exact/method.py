@@ -1,4 +1,4 @@
-r"""The closed-form motion of the free rigid body (``method="exact"``).
+r"""The closed-form motion (``method="exact"``): the free rigid body and the Lagrange top.
 
 The body angular momentum is given by Jacobi elliptic functions and the
 attitude by the rotation that takes the constant spatial angular momentum to
@@ -13,6 +13,13 @@ motion from the identity,
 .. math:: R(t) = R_0\,P\,R_P(t)\,P^T, \qquad \boldsymbol\Omega(t) = P\,\boldsymbol\Omega_P(t),
 
 which is exact because the free body is left-invariant.
+
+A heavy symmetric top with its centre of mass on the symmetry axis (the
+Lagrange top: :meth:`~eulerpoisson.Model.lagrange_top` recognizes it in any
+body frame) is solved in closed form too (:mod:`.lagrange`): the body frame
+is turned so that the symmetry axis is :math:`\mathbf e_3` (:math:`R_{top} =
+RF`), solved there and turned back. Other torques are refused with
+:class:`~eulerpoisson.errors.UnsupportedModelError`.
 
 References
 ----------
@@ -88,7 +95,10 @@ class Exact(Method):
 
     Accurate to a few ulps times :math:`|\boldsymbol\Omega||t|` (the
     conditioning of the phase), O(1) per output time, vectorized over bodies
-    and times; no options.
+    and times; no options. Models: the free body, and the Lagrange top (a
+    symmetric body, centre of mass on the symmetry axis, one
+    :class:`~eulerpoisson.torques.Gravity`; every regime, see
+    :mod:`.lagrange`).
 
     Raises
     ------
@@ -102,8 +112,18 @@ class Exact(Method):
     order = None
     description = "closed form (Jacobi elliptic functions, elliptic integral of the third kind)"
 
+    @classmethod
+    def supports(cls, model) -> str | None:
+        if model.is_free or _lagrange_parameters(model) is not None:
+            return None
+        return ("the closed form covers the free body and the Lagrange top (a symmetric body with its centre of mass "
+                f"on the symmetry axis under one Gravity torque), and the model has {model.describe()}")
+
     def run(self, problem: Problem) -> MethodResult:
         from .motion import exact_motion
+
+        if not problem.model.is_free:
+            return self._run_lagrange(problem)
 
         _check_phase_range(problem)
         P = problem.principal_axes  # (*B, 3, 3), det +1
@@ -118,3 +138,36 @@ class Exact(Method):
             q_rel = qmul(qmul(qP, q_rel), qPc)
         q = compose_initial(problem, q_rel)
         return MethodResult(q=q, omega=omega, stats={"evaluations": int(np.prod(q.shape[:-1]))})
+
+    def _run_lagrange(self, problem: Problem) -> MethodResult:
+        from .lagrange import lagrange_top_motion
+
+        bshape = problem.batch_shape
+        A, C, mass, ell, g, F = (np.broadcast_to(x, bshape + x.shape[len(problem.model.batch_shape):])
+                                 for x in _lagrange_parameters(problem.model))
+        qF = quaternion_from_rotation_matrix(F)
+        q0 = qmul(problem.q0, qF)
+        w0 = np.einsum("...ji,...j->...i", F, problem.omega0)
+        q, w = lagrange_top_motion(A, C, mass, ell, g, q0, w0, problem.t)
+        q = qmul(q, (qF * np.array([1.0, -1.0, -1.0, -1.0]))[..., None, :])
+        w = np.einsum("...ij,...tj->...ti", F, w)
+        return MethodResult(q=q, omega=w, stats={"evaluations": int(np.prod(q.shape[:-1])), "model": "lagrange top"})
+
+
+def _lagrange_parameters(model):
+    """``(A, C, mass, ell, g, F)`` of a (batch of) Lagrange top(s), each with the model's batch shape, or None."""
+    shape = model.batch_shape
+    rows = []
+    for idx in np.ndindex(*shape) if shape else [()]:
+        lt = (model.element(idx) if shape else model).lagrange_top()
+        if lt is None:
+            return None
+        rows.append(lt)
+    if not shape:
+        lt = rows[0]
+        return lt.A, lt.C, lt.mass, lt.ell, lt.g, lt.frame
+
+    def stack(k, tail):
+        return np.array([np.asarray(r[k], dtype=float) for r in rows]).reshape(shape + tail)
+
+    return stack(0, ()), stack(1, ()), stack(2, ()), stack(3, ()), stack(4, (3,)), stack(5, (3, 3))

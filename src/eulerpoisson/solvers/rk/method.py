@@ -46,6 +46,7 @@ import numpy as np
 
 from ...errors import EulerPoissonError, InvalidInputError
 from ...model.free_body import euler_coefficients
+from ...numerics.quaternion import qmul_components
 from ..problem import Problem
 from ..registry import Method, MethodOptions, MethodResult, register_method
 from .. import charts as ch
@@ -64,17 +65,8 @@ def _rhs_quaternion(inv_moments, moments):
 
     def f(t, y):
         w, x, yy, z, o1, o2, o3 = y
-        return np.array(
-            [
-                -0.5 * (x * o1 + yy * o2 + z * o3),
-                0.5 * (w * o1 + yy * o3 - z * o2),
-                0.5 * (w * o2 - x * o3 + z * o1),
-                0.5 * (w * o3 + x * o2 - yy * o1),
-                a1 * o2 * o3,
-                a2 * o3 * o1,
-                a3 * o1 * o2,
-            ]
-        )
+        d0, d1, d2, d3 = qmul_components(w, x, yy, z, 0.0, o1, o2, o3)
+        return np.array([0.5 * d0, 0.5 * d1, 0.5 * d2, 0.5 * d3, a1 * o2 * o3, a2 * o3 * o1, a3 * o1 * o2])
 
     return f
 

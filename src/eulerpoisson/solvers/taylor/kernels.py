@@ -574,10 +574,7 @@ def _nb_coefficients(moments, n0, w0, order):
 
 def _nb_quat_gibbs(pw, px, py, pz, nx, ny, nz):
     """Unit quaternion p (x) (1, n)/|(1, n)| (compiled without ``contract``, as :func:`_nb_chart`)."""
-    q0 = pw - px * nx - py * ny - pz * nz
-    q1 = pw * nx + px + py * nz - pz * ny
-    q2 = pw * ny - px * nz + py + pz * nx
-    q3 = pw * nz + px * ny - py * nx + pz
+    q0, q1, q2, q3 = qmul_components(pw, px, py, pz, 1.0, nx, ny, nz)  # times 1.0: exact, the same bits
     r = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
     return q0 / r, q1 / r, q2 / r, q3 / r
 

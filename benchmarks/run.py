@@ -10,7 +10,11 @@ summary when present):
 ``long_run``
     to t = 1e5: time, energy error and attitude error: ``long_run.json``;
 ``throughput``
-    batched evaluation and integration rates: ``throughput.json``.
+    batched evaluation and integration rates: ``throughput.json``;
+``torque``
+    bodies under torque: taylor step cost with gravity against the free body, the exact Lagrange top
+    per evaluation, the exact splitting's rate, accuracy of taylor and rk on a heavy top:
+    ``torque.json``.
 
 ``summary.md`` gathers the tables, the ratios against the peers measured in the same run and a
 PASS/MISS column for each goal of the issue, with the machine and the command. Every
@@ -46,7 +50,7 @@ if str(HERE) not in sys.path:
 import _common as C  # noqa: E402
 
 DEFAULT_OUT = HERE / "results"
-BENCHMARKS = ("work_precision", "long_run", "throughput")
+BENCHMARKS = ("work_precision", "long_run", "throughput", "torque")
 README = HERE / "README.md"
 README_START = "<!-- results:start -->"
 README_END = "<!-- results:end -->"
@@ -83,7 +87,7 @@ def _status(ok):
     return "PASS" if ok else "MISS"
 
 
-def evaluate_goals(wp, lr, tp) -> list[dict]:
+def evaluate_goals(wp, lr, tp, tq=None) -> list[dict]:
     """One row per goal of the issue: target, measured value(s), ratio to the peer, PASS/MISS/N/A."""
     goals = []
 
@@ -172,6 +176,19 @@ def evaluate_goals(wp, lr, tp) -> list[dict]:
         g.setdefault("measured", "not run")
         g.setdefault("ratio", None)
         g.setdefault("status", "N/A")
+    if tq:
+        r = _row(tq["rows"], "taylor_gravity_ratio")
+        g = {"goal": "taylor: a step under gravity within 1.5x the cost of a free-body step",
+             "target": "t_step(heavy top) / t_step(free body) <= 1.5"}
+        g["measured"] = (f"{_row(tq['rows'], 'taylor_gravity_step')['value']:.3g} us vs "
+                         f"{_row(tq['rows'], 'taylor_free_step')['value']:.3g} us per step")
+        g["ratio"] = r["value"]
+        g["status"] = _status(r["value"] <= 1.5)
+        goals.append(g)
+        r = _row(tq["rows"], "exact_lagrange")
+        g = {"goal": "exact: the Lagrange top <= 1 us per evaluation", "target": "<= 1 us per (body, time)",
+             "measured": f"{r['value']:.3g} us per (body, time)", "ratio": r["value"], "status": _status(r["value"] <= 1.0)}
+        goals.append(g)
     return goals
 
 
@@ -182,7 +199,7 @@ def _fmt_ratio(r):
     return "" if r is None else f"{r:.3g}"
 
 
-def summary_markdown(wp, lr, tp, goals, machine, command, quick) -> str:
+def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None) -> str:
     L = []
     L.append("# Benchmark summary")
     L.append("")
@@ -259,6 +276,15 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick) -> str:
             L.append("")
             L.append(f"One exact evaluation (body, time, attitude included) costs "
                      f"{ex['us_per_evaluation'] * 1e3 / ej['value']:.3g} scipy ellipj evaluations.")
+    if tq:
+        L.append("")
+        L.append("## Bodies under torque (one thread)")
+        L.append("")
+        L.append("| what | value | unit | attitude error (rad) |")
+        L.append("|---|---|---|---|")
+        for r in tq["rows"]:
+            e = r.get("attitude_error_rad")
+            L.append(f"| {r['label']} | {r['value']:.3g} | {r['unit']} | {'-' if e is None else f'{e:.1e}'} |")
     L.append("")
     L.append("## Reference points quoted by the issue (2-core machine, not measured here)")
     L.append("")
@@ -329,19 +355,19 @@ def main(argv=None) -> int:
         elif path.exists():
             results[name] = json.loads(path.read_text())
     machine["load_average_at_end"] = C.load_average()
-    wp, lr, tp = (results.get(n) for n in BENCHMARKS)
+    wp, lr, tp, tq = (results.get(n) for n in BENCHMARKS)
     if args.summary_only:
         # describe the machine and command of the runs that produced the JSON, not of this call
-        runs = [r for r in (wp, lr, tp) if r]
+        runs = [r for r in (wp, lr, tp, tq) if r]
         if runs:
             machine, command = dict(runs[0]["machine"]), runs[0]["command"]
             ends = [r["machine"].get("load_average_at_end") for r in runs]
             machine["load_average_at_end"] = max((e for e in ends if e is not None), default=None)
             args.quick = bool(runs[0].get("quick"))
-    goals = evaluate_goals(wp, lr, tp)
+    goals = evaluate_goals(wp, lr, tp, tq)
     C.write_json(out / "goals.json", C.envelope("goals", quick=args.quick, command=command, machine=machine,
                                                 goals=goals))
-    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick)
+    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq)
     (out / "summary.md").write_text(summary)
     print(f"  -> {out / 'summary.md'}")
     for g in goals:

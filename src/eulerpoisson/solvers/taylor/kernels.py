@@ -457,10 +457,8 @@ def _integrate_numpy(moments, w0, qref0, t, tol, order, dt, max_steps, threshold
                 # compensated state update (two-sum) and time
                 _two_sum_into(n, nlo, _horner_delta(N[:, :, adv], hv), sl)
                 _two_sum_into(w, wlo, _horner_delta(W[:, :, adv], hv), sl)
-                ts = th[sl]
-                s = ts + hv
-                z = s - ts
-                tc[sl] = tc[sl] + ((ts - (s - z)) + (hv - z))
+                s, e = two_sum(th[sl], hv)
+                tc[sl] = tc[sl] + e
                 th[sl] = s
                 nn = n[0, sl] * n[0, sl] + n[1, sl] * n[1, sl] + n[2, sl] * n[2, sl]
                 nnf = _to_float(nn)
@@ -753,21 +751,11 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
                 # compensated update x <- x + dx (two-sum: x + xlo is the state)
                 _nb_horner_delta(N, W, order, hs, dn, dw)
                 for c in range(3):
-                    y = dn[c] + nlo[c]
-                    s = n[c] + y
-                    z = s - n[c]
-                    nlo[c] = (n[c] - (s - z)) + (y - z)
-                    n[c] = s
-                    y = dw[c] + wlo[c]
-                    s = w[c] + y
-                    z = s - w[c]
-                    wlo[c] = (w[c] - (s - z)) + (y - z)
-                    w[c] = s
+                    n[c], nlo[c] = two_sum(n[c], dn[c] + nlo[c])
+                    w[c], wlo[c] = two_sum(w[c], dw[c] + wlo[c])
                 # time: two-sum, t = th + tc
-                s = th + hs
-                z = s - th
-                tc += (th - (s - z)) + (hs - z)
-                th = s
+                th, e = two_sum(th, hs)
+                tc += e
                 nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
                 if nn > thr2:
                     q0, q1, q2, q3 = _nb_quat_gibbs(qr[0], qr[1], qr[2], qr[3], n[0], n[1], n[2])
@@ -1128,6 +1116,7 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
             for l in range(_TL):
                 hl = x[_XH + l]
                 cur = x[_XN + c * _TL + l]
+                # two-sum written out (numerics.doubledouble.two_sum): this loop over the lanes must vectorize
                 y = _nb_mul(x[_XDN + c * _TL + l], hl) + x[_XNL + c * _TL + l]
                 s = cur + y
                 z = s - cur
@@ -1144,10 +1133,8 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
             if adv[l] == 0:
                 continue
             hs = x[_XH + l]
-            th = x[_XTH + l]
-            s = th + hs
-            z = s - th
-            x[_XTC + l] += (th - (s - z)) + (hs - z)
+            s, e = two_sum(x[_XTH + l], hs)
+            x[_XTC + l] += e
             x[_XTH + l] = s
             n0 = x[_XN + l]
             n1 = x[_XN + _TL + l]

@@ -107,6 +107,8 @@ _TOML_KINDS = {
     "method": {"name": "str", "tol": "number", "dt": "number", "scheme": "str", "order": "int",
                "integrator": "str", "rtol": "number", "atol": "number"},
     "output": {"file": "str", "json": "bool"},
+    "torque": {"gravity": "numbers", "mass": "number", "center_of_mass": "numbers", "gravity_gradient": "number",
+               "body_torque": "numbers", "space_torque": "numbers"},
 }
 _TOML_KEYS = {sec: set(keys) for sec, keys in _TOML_KINDS.items()}
 
@@ -202,6 +204,12 @@ _FLAGS = {
     "method.dt": "--dt",
     "method.scheme": "--scheme",
     "output.file": "--out",
+    "torque.gravity": "--gravity",
+    "torque.mass": "--mass",
+    "torque.center_of_mass": "--com",
+    "torque.gravity_gradient": "--gravity-gradient",
+    "torque.body_torque": "--body-torque",
+    "torque.space_torque": "--space-torque",
 }
 
 
@@ -269,6 +277,48 @@ def _build_body(cfg, name=None):
     return RigidBody(_inertia_from(cfg["body.inertia"], name("body.inertia")), name=label)
 
 
+def _number(value, name: str, *, positive: bool = False) -> float:
+    """One finite number (a flag's text or a TOML number); ``positive``: > 0, else >= 0."""
+    try:
+        x = float(str(value).strip()) if isinstance(value, str) else float(value)
+    except (TypeError, ValueError):
+        raise UsageError(f"{name}: {value!r} is not a number") from None
+    if not math.isfinite(x) or (x <= 0 if positive else x < 0):
+        raise UsageError(f"{name} must be a finite number {'> 0' if positive else '>= 0'}, got {value!r}")
+    return x
+
+
+def _build_torques(cfg, name=None) -> list:
+    """The torques of ``[torque]`` / the torque flags, in the order gravity, gravity gradient, body, space.
+
+    A heavy top needs the centre of mass (``--com``); the mass defaults to 1 and
+    the gravitational acceleration to (0, 0, -9.81).
+    """
+    from ..model.torques import STANDARD_GRAVITY, BodyTorque, Gravity, GravityGradient, SpaceTorque
+
+    name = name or _namer({})
+    torques = []
+    if "torque.center_of_mass" in cfg:
+        com = _floats(cfg["torque.center_of_mass"], name("torque.center_of_mass"), (3,))
+        mass = _number(cfg["torque.mass"], name("torque.mass"), positive=True) if "torque.mass" in cfg else 1.0
+        g = (_floats(cfg["torque.gravity"], name("torque.gravity"), (3,)) if "torque.gravity" in cfg
+             else [0.0, 0.0, -STANDARD_GRAVITY])
+        torques.append(Gravity(mass, com, g))
+    else:
+        for key in ("torque.mass", "torque.gravity"):
+            if key in cfg:
+                raise UsageError(f"{name(key)} needs the centre of mass of the heavy top: "
+                                 f"{_FLAGS['torque.center_of_mass']} CX,CY,CZ (body frame, from the fixed point) "
+                                 "or [torque] center_of_mass")
+    if "torque.gravity_gradient" in cfg:
+        torques.append(GravityGradient(_number(cfg["torque.gravity_gradient"], name("torque.gravity_gradient"))))
+    if "torque.body_torque" in cfg:
+        torques.append(BodyTorque(_floats(cfg["torque.body_torque"], name("torque.body_torque"), (3,))))
+    if "torque.space_torque" in cfg:
+        torques.append(SpaceTorque(_floats(cfg["torque.space_torque"], name("torque.space_torque"), (3,))))
+    return torques
+
+
 def _method_options(cfg, name=None) -> dict:
     name = name or _namer({})
     opts = {}
@@ -289,6 +339,10 @@ def _method_options(cfg, name=None) -> dict:
     return opts
 
 
+def _torque_records(model) -> list[dict]:
+    return [tq.to_dict() for tq in model.torques]
+
+
 def _state_json(traj, drift) -> dict:
     i = int(np.argmax(traj.t))
     q = traj.quaternion[..., i, :]
@@ -302,6 +356,8 @@ def _state_json(traj, drift) -> dict:
         "energy": float(traj.energy[..., i]),
         "method": traj.method,
         "drift": {k: float(v) for k, v in drift.items()},
+        "torque": _torque_records(traj.model),
+        "integrals": {k: float(v[..., i]) for k, v in traj.integrals().items()},
     }
 
 
@@ -310,7 +366,7 @@ CHUNKED_SAMPLES = 5000
 CHUNKS = 50
 
 
-def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
+def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
     """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
 
     The chunking depends only on the number of samples (never on whether a
@@ -320,11 +376,11 @@ def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
     previous one, as :func:`eulerpoisson.io.stream.solve_to_file` does.
     """
     from ..solvers import get_method, solve
-    from ..io.stream import ProgressDisplay
+    from ..io.stream import ProgressDisplay, solve_from
     from ..trajectory import Trajectory
 
     if t.size < CHUNKED_SAMPLES:
-        return solve(body, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        return solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
     closed_form = get_method(method).order is None
     pieces = np.array_split(np.arange(t.size), CHUNKS)
     qs, ws, wall = [], [], 0.0
@@ -333,10 +389,11 @@ def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
         done = 0
         for idx in pieces:
             if closed_form or first is None:
-                tr = solve(body, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+                tr = solve(model, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
             else:
-                t0 = t[qs_end_index]
-                tr = solve(body, t[idx] - t0, omega0=ws[-1][-1], attitude0=qs[-1][-1], method=method, **opts)
+                # the time-dependent torques are shifted to the chunk's start (solve_from)
+                tr = solve_from(model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :],
+                                method=method, **opts)
             first = tr if first is None else first
             qs.append(tr.quaternion)
             ws.append(tr.omega)
@@ -345,12 +402,15 @@ def _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress):
             done += idx.size
             bar.update(done)
     stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
-    return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats)
+    return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats,
+                      torque=list(model.torques))
 
 
 def cmd_simulate(args) -> int:
     from ..attitude.core import quaternion_from_gibbs
+    from ..model.equations import Model
     from ..solvers import available_methods, solve
+    from ..solvers.registry import check_supported
 
     cfg: dict = {}
     src: dict = {}
@@ -369,6 +429,9 @@ def cmd_simulate(args) -> int:
         ("quaternion", "initial.quaternion"), ("gibbs", "initial.gibbs"), ("t_end", "time.t_end"),
         ("samples", "time.samples"), ("method", "method.name"), ("tol", "method.tol"), ("dt", "method.dt"),
         ("scheme", "method.scheme"), ("out", "output.file"),
+        ("gravity", "torque.gravity"), ("mass", "torque.mass"), ("com", "torque.center_of_mass"),
+        ("gravity_gradient", "torque.gravity_gradient"), ("body_torque", "torque.body_torque"),
+        ("space_torque", "torque.space_torque"),
     ) if getattr(args, attr, None) is not None}
     # two flags that say the same thing differently are an error; a flag replaces what the file says
     if "initial.omega" in given and "initial.m" in given:
@@ -431,9 +494,13 @@ def cmd_simulate(args) -> int:
             raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples!r}") from None
     if samples < 2:
         raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples}")
-    method = cfg.get("method.name", "exact")
+    torques = _build_torques(cfg, name)
+    model = Model(body, torques)
+    # the closed form runs the free body (and the Lagrange top); under a torque the default is taylor
+    method = cfg.get("method.name", "exact" if model.is_free else "taylor")
     if method not in available_methods():
         raise UsageError(f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}")
+    check_supported(method, model)  # UnsupportedModelError (one line, exit 2) names the methods that can
     opts = _method_options(cfg, name)
     out = cfg.get("output.file")
     _check_file_name(out, name("output.file"))
@@ -446,12 +513,12 @@ def cmd_simulate(args) -> int:
         from ..io.stream import solve_to_file
 
         with _naming_target(out):
-            solve_to_file(body, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
+            solve_to_file(model, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
                           progress=progress, overwrite=True, **opts)
-        traj = solve(body, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        traj = solve(model, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
     else:
         t = np.linspace(0.0, t_end, samples)
-        traj = _solve_in_chunks(body, t, omega0, m0, q0, method, opts, progress)
+        traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
         if out is not None:
             traj.to_netcdf(out)
     drift = traj.drift()
@@ -460,9 +527,11 @@ def cmd_simulate(args) -> int:
     elif not args.quiet:
         s = _state_json(traj, drift)
         print(f"{traj.method}: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.3g} s")
+        if not model.is_free:
+            print(f"  torque        {model.describe()}")
         print(f"  quaternion(T) = {np.round(s['quaternion'], 12).tolist()}")
         print(f"  omega(T)      = {np.round(s['omega'], 12).tolist()}")
-        print(f"  energy        = {s['energy']:.15g}")
+        print(f"  energy        = {s['energy']:.15g}" + ("" if model.is_free else "  (kinetic + potential)"))
         print("  relative drift: " + ", ".join(f"{k} {v:.2e}" for k, v in drift.items()))
         if out is not None:
             print(f"  wrote {out}")
@@ -570,6 +639,7 @@ def cmd_info(args) -> int:
     lines = [
         f"{args.file}: eulerpoisson trajectory",
         f"  method      {traj.method} {json.dumps(traj.options) if traj.options else ''}".rstrip(),
+        f"  torque      {traj.model.describe()}",
     ]
     if len(traj.t) == 0:  # a valid file with no output times: nothing to measure
         lines.append("  samples     0 (no output times)")
@@ -581,7 +651,8 @@ def cmd_info(args) -> int:
         lines.append(f"  bodies      batch of shape {traj.batch_shape}")
     else:
         lines.append(f"  body        {b!r}")
-        lines.append(f"  energy      {float(traj.energy[0]):.15g}")
+        lines.append(f"  energy      {float(traj.energy[0]):.15g}"
+                     + ("" if traj.model.is_free else " (kinetic + potential)"))
         lines.append(f"  m           {np.round(traj.m[0], 12).tolist()}")
     lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in traj.drift().items()))
     print("\n".join(lines))
@@ -651,16 +722,26 @@ def build_parser() -> argparse.ArgumentParser:
         "simulate",
         help="solve the motion of a body and print or save it",
         formatter_class=ex,
-        description="Solve the free rigid body from an initial state.",
+        description="Solve the motion of a rigid body, free or under torque, from an initial state.",
         epilog=(
             "examples:\n"
-            "  eulerpoisson simulate --inertia 3,5,9 --omega 0,0.4,0.001 --t-end 50 --json\n"
+            "  eulerpoisson simulate --inertia 3,5,8 --omega 0,0.4,0.001 --t-end 50 --json\n"
             "  eulerpoisson simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 100 --method taylor --tol 1e-15 --out run.nc\n"
-            "  eulerpoisson simulate run.toml --t-end 20     # flags override the file\n\n"
+            "  eulerpoisson simulate run.toml --t-end 20     # flags override the file\n"
+            "  eulerpoisson simulate --inertia 1,1,0.5 --omega 0,0,10 --gibbs 0.577,0,0 --com 0,0,0.25 --mass 1 \\\n"
+            "      --gravity 0,0,-9.81 --t-end 15 --out top.nc     # a heavy top (taylor by default)\n"
+            "  eulerpoisson plot top.nc --kind apex --out top_apex.png\n"
+            "  eulerpoisson simulate examples/heavy_top.toml --t-end 5   # the same top from a file ([torque])\n"
+            "  eulerpoisson simulate --inertia 1,2,3 --omega 0,0.001,0.001 --gravity-gradient 0.001 --t-end 6000 --json\n\n"
             "TOML file sections: [body] inertia=[...] | masses=[...], positions=[[...]...]; name\n"
             "  [initial] omega=[...] | m=[...]; quaternion=[w,x,y,z] | gibbs=[...]\n"
             "  [time] t_end, samples   [method] name, tol, dt, scheme, order, integrator, rtol, atol\n"
-            "  [output] file, json"
+            "  [output] file, json\n"
+            "  [torque] center_of_mass=[...], mass, gravity=[...]; gravity_gradient; body_torque=[...]; space_torque=[...]\n\n"
+            "Torques: a heavy top is --com (centre of mass, body frame, from the fixed point; the inertia is about\n"
+            "the fixed point) with --mass (default 1) and --gravity (default 0,0,-9.81); --gravity-gradient NU is a\n"
+            "circular orbit of mean motion NU; --body-torque / --space-torque are constant torques. They add up.\n"
+            "Under a torque the default method is taylor; rk and symplectic run them too (see --method)."
         ),
     )
     s.add_argument("config", nargs="?", help="optional TOML file describing the run")
@@ -671,12 +752,22 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--gibbs", help="initial attitude as the Gibbs vector n1,n2,n3")
     s.add_argument("--t-end", dest="t_end", help="final time T >= 0")
     s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
-    s.add_argument("--method", help="solution method (default exact)")
+    s.add_argument("--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)")
     s.add_argument("--tol", help="tolerance for adaptive methods")
     s.add_argument("--dt", help="step size for fixed-step methods")
     s.add_argument("--scheme", help="scheme of the symplectic method (gauss2, gauss4, gauss6, ...)")
-    s.add_argument("--out", help="write the trajectory to this NetCDF file")
-    s.add_argument("--json", action="store_true", help="print the state at T as one JSON object")
+    s.add_argument("--com", metavar="CX,CY,CZ",
+                   help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)")
+    s.add_argument("--mass", metavar="M", help="heavy top: mass M > 0 (default 1; needs --com)")
+    s.add_argument("--gravity", metavar="GX,GY,GZ",
+                   help="heavy top: gravitational acceleration, space frame (default 0,0,-9.81; needs --com)")
+    s.add_argument("--gravity-gradient", dest="gravity_gradient", metavar="NU",
+                   help="gravity-gradient torque of a circular orbit with mean motion NU >= 0 (rad per time unit)")
+    s.add_argument("--body-torque", dest="body_torque", metavar="TX,TY,TZ", help="constant torque in the body frame")
+    s.add_argument("--space-torque", dest="space_torque", metavar="TX,TY,TZ", help="constant torque in the space frame")
+    s.add_argument("--out", help="write the trajectory to this NetCDF (.nc) file or stream it to a Zarr (.zarr) store")
+    s.add_argument("--json", action="store_true",
+                   help="print the state at T, the torques, the integrals at T and their drift as one JSON object")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=cmd_simulate)
 
@@ -695,10 +786,11 @@ def build_parser() -> argparse.ArgumentParser:
         "plot",
         help="draw a figure from a trajectory file",
         formatter_class=ex,
-        epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf",
+        epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf\n"
+               "  eulerpoisson plot top.nc --kind apex --out apex.png   # a top: its axis on the unit sphere",
     )
     pl.add_argument("file", help="trajectory NetCDF file written by 'simulate --out' (or a sweep store for --kind atlas)")
-    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "atlas"])
+    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "apex", "atlas"])
     pl.add_argument("--out", help="figure file (.png, .svg or .pdf)")
     pl.add_argument("--quiet", action="store_true")
     pl.set_defaults(func=cmd_plot)
@@ -740,7 +832,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser(
         "demo",
-        help="the showcase: the tennis-racket effect, figures, animation and audit",
+        help="the showcase: the tennis-racket effect, a heavy top, figures, animation and audit",
         epilog="example:\n  eulerpoisson demo --out out",
         formatter_class=ex,
     )

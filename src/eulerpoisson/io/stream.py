@@ -42,8 +42,10 @@ For a stepping method (``"rk"``, ``"taylor"``, ``"symplectic"``, ...) the
 times must be strictly monotonic and chunk :math:`k>0` is solved from the
 last state of chunk :math:`k-1`: with :math:`\tau_k` that last time and
 :math:`(q, \boldsymbol\Omega)` the state there,
-``solve(body, t_chunk - tau_k, attitude0=q, omega0=Omega)`` (the free body
-is autonomous, so shifting time is exact). The result is *consistent* —
+``solve(body, t_chunk - tau_k, attitude0=q, omega0=Omega)`` (the free body,
+and a body under time-independent torques, is autonomous, so shifting time
+is exact; a time-dependent torque is shifted with it, see
+:func:`solve_from`). The result is *consistent* —
 the same integrator at the same settings, restarted at the chunk
 boundaries — but not bitwise equal to one long integration: an adaptive
 step-size controller restarts at each boundary and a fixed-step method
@@ -106,7 +108,7 @@ import numpy as np
 
 from ..errors import EulerPoissonError, InvalidInputError, require
 
-__all__ = ["TimeGrid", "solve_to_file", "partial_store", "TIME_VARIABLES"]
+__all__ = ["TimeGrid", "solve_to_file", "solve_from", "partial_store", "TIME_VARIABLES"]
 
 #: the time-dependent variables of :meth:`Trajectory.to_xarray`, all written by default
 TIME_VARIABLES = ("quaternion", "omega", "M", "m", "energy", "gibbs")
@@ -369,6 +371,142 @@ def _quiet_zarr():
 
 
 # ---------------------------------------------------------------------------
+# continuing a solution from a later state (chunks)
+# ---------------------------------------------------------------------------
+def _rotation_z(phi) -> np.ndarray:
+    """Quaternions (..., 4) of the rotations by ``phi`` about the space z axis."""
+    phi = np.asarray(phi, dtype=float)
+    return np.stack([np.cos(phi / 2), np.zeros_like(phi), np.zeros_like(phi), np.sin(phi / 2)], -1)
+
+
+def _rotate_z(v, phi) -> np.ndarray:
+    """Space vectors ``v`` (..., 3) rotated by ``phi`` (...) about z."""
+    v = np.asarray(v, dtype=float)
+    c, s = np.cos(phi), np.sin(phi)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1],
+                     np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, np.shape(c)))], -1)
+
+
+def _shifted_torques(torques, t_start: float):
+    r"""The torques seen from time ``t_start`` on: ``(torques', phi)``.
+
+    With :math:`s = t - t_\mathrm{start}`, the motion under ``torques'``
+    from the state at ``t_start`` rotated by :math:`R_z(-\varphi)` is the
+    original motion, rotated by :math:`R_z(-\varphi)` in space. A gravity
+    gradient of mean motion :math:`\nu` is the same torque in the space frame
+    turned by :math:`\varphi = \nu t_\mathrm{start}` (its orbit direction is
+    :math:`\hat{\mathbf r}(t_\mathrm{start} + s) = R_z(\varphi)\hat{\mathbf r}(s)`),
+    so space-fixed vectors of the other torques (gravity, a space-frame torque)
+    are turned by :math:`-\varphi`; a Python function is called at the shifted
+    time with the attitude turned back. Body-frame torques are unchanged.
+
+    Raises
+    ------
+    InvalidInputError
+        A time-dependent torque of a class that cannot be shifted.
+    """
+    from ..model.torques import BodyTorque, CallableTorque, Gravity, GravityGradient, SpaceTorque
+    from ..numerics.quaternion import qmul
+
+    grads = [tq for tq in torques if isinstance(tq, GravityGradient)]
+    phi = np.zeros(())
+    for tq in grads:
+        if np.any(tq.mean_motion != 0):
+            phi = np.asarray(tq.mean_motion, dtype=float) * t_start
+            break
+    turn = bool(np.any(phi != 0))
+    out = []
+    for tq in torques:
+        if isinstance(tq, (GravityGradient, BodyTorque)):
+            out.append(tq)
+        elif isinstance(tq, Gravity):
+            out.append(Gravity(tq.mass, tq.center_of_mass, _rotate_z(tq.g, -phi)) if turn else tq)
+        elif isinstance(tq, SpaceTorque):
+            out.append(SpaceTorque(_rotate_z(tq.tau, -phi)) if turn else tq)
+        elif isinstance(tq, CallableTorque):
+            func, rz = tq.func, _rotation_z(phi)
+
+            def shifted(s, q, omega, _f=func, _rz=rz, _turn=turn):
+                return _f(np.asarray(s) + t_start, qmul(_rz, q) if _turn else q, omega)
+
+            shifted.__name__ = getattr(func, "__name__", "torque")
+            out.append(CallableTorque(shifted))
+        elif tq.time_dependent or turn:
+            raise InvalidInputError(
+                f"the torque {tq!r} depends on time (or on the space frame with a gravity gradient) and "
+                "cannot be continued from a later state; solve the run in one piece"
+            )
+        else:
+            out.append(tq)
+    return out, phi
+
+
+def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, **options):
+    r"""Continue a motion from its state at ``t_start`` to the (absolute) output times ``t``.
+
+    The building block of long runs solved chunk by chunk: the model is
+    autonomous unless a torque depends on time, so
+    ``solve(model, t - t_start, attitude0=q_start, omega0=omega_start)``
+    continues the motion; time-dependent torques (a gravity gradient, a
+    Python function) are shifted by ``t_start`` so that the result is the same
+    motion (see :func:`_shifted_torques`).
+
+    Parameters
+    ----------
+    model : Model, RigidBody or array_like
+        The equations of motion (a body alone: the free body).
+    t : array_like, shape (T,)
+        Absolute output times.
+    t_start : float
+        Time of the state ``(q_start, omega_start)``.
+    q_start, omega_start : array_like, shapes (..., 4) and (..., 3)
+    method : str
+    **options
+        Method options.
+
+    Returns
+    -------
+    Trajectory
+        At the absolute times ``t``, with the original model (so that the
+        energy, the integrals and the drift are those of the motion).
+    """
+    from ..model.equations import Model, as_model
+    from ..numerics.quaternion import qmul
+    from ..solvers import solve
+    from ..trajectory import Trajectory
+
+    model = as_model(model)
+    t = np.asarray(t, dtype=float)
+    t_start = float(t_start)
+    if model.is_autonomous or t_start == 0.0:
+        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, **options)
+        tr.t = t
+        return tr
+    torques, phi = _shifted_torques(model.torques, t_start)
+    q_start = np.asarray(q_start, dtype=float)
+    turned = bool(np.any(phi != 0))
+    if turned:
+        rz = _rotation_z(phi)
+        q_start = qmul(rz * np.array([1.0, -1.0, -1.0, -1.0]), q_start)
+    tr = solve(Model(model.body, torques), t - t_start, omega0=omega_start, attitude0=q_start, method=method,
+               **options)
+    q = tr.quaternion
+    if turned:
+        q = qmul(_rotation_z(phi)[..., None, :], q)
+    return Trajectory(t, q, tr.omega, model.body, tr.method, tr.options, tr.stats, torque=list(model.torques))
+
+
+def _torque_fingerprint(model) -> list:
+    out = []
+    for tq in model.torques:
+        try:
+            out.append(tq.to_dict())
+        except NotImplementedError:
+            out.append({"kind": "unrecorded", "description": repr(tq)})
+    return json.loads(json.dumps(out, default=float, sort_keys=True))
+
+
+# ---------------------------------------------------------------------------
 # the streaming solver
 # ---------------------------------------------------------------------------
 def _chunk_arrays(traj, variables) -> dict[str, np.ndarray]:
@@ -393,6 +531,7 @@ def solve_to_file(
     omega0=None,
     m0=None,
     attitude0=None,
+    torque=None,
     method: str = "exact",
     chunk: int = 100_000,
     progress=None,
@@ -405,8 +544,9 @@ def solve_to_file(
 
     Parameters
     ----------
-    body : RigidBody or array_like
-        The body or a batch of bodies, as for :func:`~eulerpoisson.solve`.
+    body : RigidBody, Model or array_like
+        The body or a batch of bodies (or a :class:`~eulerpoisson.Model`
+        with its torques), as for :func:`~eulerpoisson.solve`.
     t : tuple (t0, t1, n), TimeGrid or array_like, shape (T,)
         Output times: ``(t0, t1, n)`` generates ``numpy.linspace(t0, t1, n)``
         lazily, chunk by chunk; an array(-like) is read chunk by chunk (see
@@ -415,6 +555,11 @@ def solve_to_file(
         Destination Zarr store (a folder), written atomically.
     omega0, m0, attitude0
         Initial state at :math:`t = 0`, as for :func:`~eulerpoisson.solve`.
+    torque : Torque, callable, list of them, or None
+        Torques, as for :func:`~eulerpoisson.solve`; recorded in the
+        store's ``torque`` attribute (JSON records, as in a NetCDF file) and
+        in the resume fingerprint. A time-dependent torque is shifted to each
+        chunk's start (:func:`solve_from`).
     method : str
         A registered method; closed-form ones (``"exact"``) are evaluated
         chunk by chunk independently, stepping ones continue from the last
@@ -450,6 +595,8 @@ def solve_to_file(
     TypeError
         Bad initial-state combination, an unknown method option, a bad
         ``progress`` or non-integer ``chunk``.
+    UnsupportedModelError
+        The method cannot run the model (before anything is written).
     InvalidInputError
         Bad body, state or times; an unknown variable; ``chunk < 1``;
         non-monotonic times with a stepping method; ``resume=True`` with
@@ -474,6 +621,7 @@ def solve_to_file(
     """
     from ..util.validate import as_scalar
     from ..solvers import get_method, make_problem, solve
+    from ..solvers.registry import check_supported
     from ..trajectory import Trajectory
 
     zarr = require("zarr", "dask")
@@ -502,7 +650,9 @@ def solve_to_file(
     src = _as_time_source(t)
     n = len(src)
     t_first = _read_times(src, 0, 1)
-    problem = make_problem(body, t_first, omega0=omega0, m0=m0, attitude0=attitude0)
+    problem = make_problem(body, t_first, omega0=omega0, m0=m0, attitude0=attitude0, torque=torque)
+    check_supported(method, problem.model)
+    model = problem.model
     if not cls.negative_times and np.any(t_first < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
     bshape = problem.batch_shape
@@ -521,6 +671,8 @@ def solve_to_file(
         "n": n,
         "variables": variables,
     }
+    if not model.is_free:  # (free runs keep the fingerprint of earlier versions: their partial runs resume)
+        fingerprint["torque"] = _torque_fingerprint(model)
 
     if overwrite:
         _check_replaceable(path)  # before any work, not after
@@ -559,6 +711,7 @@ def solve_to_file(
         body=problem.body,
         method=method,
         options=dict(meth.config),
+        torque=list(model.torques),
     ).to_xarray()
 
     if not work.exists():
@@ -625,9 +778,9 @@ def solve_to_file(
                     _check_monotonic(tc, prev_t, a, direction)
                 start = _time.perf_counter()
                 if closed_form or prev_q is None:
-                    tr = solve(problem.body, tc, omega0=problem.omega0, attitude0=problem.q0, method=method, **options)
+                    tr = solve(model, tc, omega0=problem.omega0, attitude0=problem.q0, method=method, **options)
                 else:
-                    tr = solve(problem.body, tc - prev_t, omega0=prev_w, attitude0=prev_q, method=method, **options)
+                    tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, **options)
                 q = tr.quaternion
                 if prev_q is not None:
                     # keep the quaternion sign continuous across the chunk boundary

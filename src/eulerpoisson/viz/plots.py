@@ -20,6 +20,9 @@ kind           picture
                origin)
 ``attitude``   the principal axes of the body traced on the unit sphere, with
                the fixed direction of :math:`\mathbf m`
+``apex``       the locus of the symmetry axis of a top (through the centre of
+               mass) on the unit sphere, seen from above: precession,
+               nutation loops and cusps
 ============== ==============================================================
 
 Conventions of the pictures
@@ -92,12 +95,14 @@ __all__ = [
     "plot_polhode",
     "plot_gibbs",
     "plot_attitude",
+    "plot_apex",
+    "apex_axis",
     "chart_segments",
     "sphere_conic",
 ]
 
 #: picture kinds accepted by :func:`plot`
-KINDS = ("omega", "invariants", "polhode", "gibbs", "attitude")
+KINDS = ("omega", "invariants", "polhode", "gibbs", "attitude", "apex")
 
 #: file formats accepted by :func:`plot` (by the extension of ``out``)
 FORMATS = ("png", "svg", "pdf")
@@ -805,6 +810,168 @@ def plot_attitude(traj, ax=None, fig=None, *, index=0, **style):
 
 
 # ---------------------------------------------------------------------------
+# apex (tops)
+# ---------------------------------------------------------------------------
+_MAX_APEX_POINTS = 40000  # longer series are strided (cusps stay sharp at this density)
+
+
+def _model_of(traj, index):
+    """The model (body and torques) of the body drawn by ``select_body(traj, index)``."""
+    model = traj.model
+    bshape = traj.batch_shape
+    if not bshape or not model.batch_shape:
+        return model
+    if isinstance(index, tuple):
+        idx = tuple(int(i) % n for i, n in zip(index, bshape))
+    else:
+        idx = np.unravel_index(int(index) % int(np.prod(bshape)), bshape)
+    return model.element(tuple(int(i) for i in idx))
+
+
+def apex_axis(model, one=None) -> tuple[np.ndarray, str]:
+    r"""The body axis whose locus ``apex`` draws, and its name: ``(unit vector, label)``.
+
+    The direction of the centre of mass from the fixed point for a heavy top
+    (the first :class:`~eulerpoisson.torques.Gravity` with a centre of mass
+    off the origin); otherwise the symmetry axis of a symmetric body (the
+    principal axis of the moment that differs from the other two); otherwise
+    the principal axis 3.
+    """
+    from ..model.torques import Gravity
+
+    for tq in model.torques:
+        if isinstance(tq, Gravity):
+            c = np.asarray(tq.center_of_mass, dtype=float).reshape(-1, 3)[0]
+            n = float(np.linalg.norm(c))
+            if n > 0:
+                return c / n, "e = c/|c| (centre of mass)"
+    moments = one.moments if one is not None else np.asarray(model.body.principal_moments).reshape(-1, 3)[0]
+    axes = one.axes if one is not None else np.asarray(model.body.principal_axes).reshape(-1, 3, 3)[0]
+    scale = max(float(np.max(np.abs(moments))), 1e-300)
+    for i in range(3):
+        j, l = [a for a in range(3) if a != i]
+        if abs(moments[j] - moments[l]) <= 1e-9 * scale and abs(moments[i] - moments[j]) > 1e-9 * scale:
+            return axes[:, i], f"e = symmetry axis {i + 1}"
+    return axes[:, 2], "e = principal axis 3"
+
+
+def _view_up(model, one) -> tuple[np.ndarray, str]:
+    """The space direction seen from above: against gravity, else along m (free body), else z."""
+    from ..model.torques import Gravity
+
+    for tq in model.torques:
+        if isinstance(tq, Gravity):
+            g = np.asarray(tq.g, dtype=float).reshape(-1, 3)[0]
+            n = float(np.linalg.norm(g))
+            if n > 0:
+                return -g / n, "vertical −g/|g|"
+    if model.is_free:
+        m0 = one.m[one.first]
+        n = float(np.linalg.norm(m0))
+        if n > 0:
+            return m0 / n, "m/|m|"
+    return np.array([0.0, 0.0, 1.0]), "space z"
+
+
+def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **style):
+    r"""The locus of a top's symmetry axis on the unit sphere, seen from above.
+
+    The unit vector :math:`\mathbf a(t) = R(t)\mathbf e` of the body axis
+    :math:`\mathbf e` through the centre of mass (:func:`apex_axis`; for a
+    free symmetric body its symmetry axis) is drawn in the orthographic
+    projection of the sphere seen from the top: along :math:`-\mathbf g` for
+    a heavy top, along the fixed :math:`\mathbf m` for a free body, along the
+    space :math:`z` axis otherwise. The curve is coloured by time, with start
+    (●) and end (■) marked; circles of constant polar angle (every 15°) and
+    the horizon (90°) are drawn, and a part of the curve below the horizon is
+    dashed. A fast top precesses slowly around the vertical while it nutates
+    between two circles: cusps when it is released without transverse spin,
+    loops or waves otherwise. Long runs are strided to at most 40 000 points.
+
+    Parameters
+    ----------
+    traj, ax, fig, index
+        As for :func:`plot_omega`; ``ax`` must be 2-D.
+    axis : array_like, shape (3,), optional
+        The body axis to follow instead of :func:`apex_axis`.
+    cmap : str
+        Colour map of the time.
+    **style
+        Passed to the line collection (``linewidth``, ...).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    TypeError, InvalidInputError, MissingDependencyError
+        As for :func:`plot_omega`; a zero or non-finite ``axis``.
+    """
+    one = select_body(traj, index)
+    model = _model_of(traj, index)
+    if axis is None:
+        e, what = apex_axis(model, one)
+    else:
+        e = np.asarray(axis, dtype=float).reshape(-1)
+        if e.shape != (3,) or not np.all(np.isfinite(e)) or not np.linalg.norm(e) > 0:
+            raise InvalidInputError(f"axis must be three finite numbers, not all zero; got {axis!r}")
+        e = e / np.linalg.norm(e)
+        what = "e = (" + ", ".join(_fmt(v) for v in e) + ")"
+    up, up_name = _view_up(model, one)
+    # an orthonormal frame (u, v, up) of the view
+    helper = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = helper - up * np.dot(helper, up)
+    u /= np.linalg.norm(u)
+    v = np.cross(up, u)
+    sl = slice(None, None, max(1, -(-len(one.t) // _MAX_APEX_POINTS)))
+    t = one.t[sl]
+    a = np.einsum("tij,j->ti", matrix_from_unit_quaternion(one.q[sl]), e)
+    x, y, h = a @ u, a @ v, a @ up
+    theta = np.degrees(np.arccos(np.clip(h, -1.0, 1.0)))
+    mpl = import_matplotlib()
+    from matplotlib.collections import LineCollection
+
+    with mpl.rc_context(STYLE):
+        fig, ax = _new_axes(ax, fig, False, (6.4, 5.8))
+        rmax = 1.0 if np.any(h < 0) else float(np.max(np.hypot(x, y)))
+        lim = min(1.06, max(1.15 * rmax, 0.05))
+        ang = np.linspace(0.0, 2 * np.pi, 361)
+        for deg in range(15, 91, 15):
+            r = np.sin(np.radians(deg))
+            if r > 1.3 * lim:
+                break
+            ax.plot(r * np.cos(ang), r * np.sin(ang), color="0.55" if deg == 90 else "0.8",
+                    lw=1.0 if deg == 90 else 0.6, zorder=1)
+            if deg % 30 == 0:
+                ax.annotate(f"{deg}°", (r * np.cos(np.pi / 4), r * np.sin(np.pi / 4)), color="0.45", fontsize=7.5,
+                            ha="left", va="bottom", zorder=1)
+        pts = np.stack([x, y], -1)
+        segs = np.stack([pts[:-1], pts[1:]], 1)
+        below = (h[:-1] < 0) & (h[1:] < 0)
+        kw = {"linewidth": 1.1, **style}
+        lc = LineCollection(segs, cmap=cmap, linestyles=[(0, (3, 2)) if b else "solid" for b in below], **kw)
+        lc.set_array(0.5 * (t[:-1] + t[1:]) if t.size > 1 else t)
+        ax.add_collection(lc)
+        ax.scatter([x[0]], [y[0]], color="k", marker="o", s=26, zorder=3, label="start")
+        ax.scatter([x[-1]], [y[-1]], color="k", marker="s", s=22, zorder=3, label="end")
+        ax.scatter([0.0], [0.0], color="0.3", marker="+", s=60, zorder=2, label=f"up: {up_name}")
+        cb = fig.colorbar(lc, ax=ax, shrink=0.8, pad=0.02)
+        cb.set_label(f"time t [{one.time_unit}]")
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_aspect("equal")
+        ax.set_xlabel("horizontal component 1 [dimensionless]")
+        ax.set_ylabel("horizontal component 2 [dimensionless]")
+        ax.legend(loc="lower left", fontsize=8)
+        ax.text(0.99, 0.01, f"polar angle {np.min(theta):.1f}° to {np.max(theta):.1f}°", transform=ax.transAxes,
+                ha="right", va="bottom", fontsize=8, color="0.3")
+        ax.grid(False)
+        ax.set_title(_title(one, f"Axis R(t)·e on the unit sphere seen from above, {what}"))
+    return fig
+
+
+# ---------------------------------------------------------------------------
 # dispatch
 # ---------------------------------------------------------------------------
 _PLOTTERS = {
@@ -813,6 +980,7 @@ _PLOTTERS = {
     "polhode": plot_polhode,
     "gibbs": plot_gibbs,
     "attitude": plot_attitude,
+    "apex": plot_apex,
 }
 
 
@@ -852,7 +1020,7 @@ def plot(traj, kind: str, out=None, *, index=0, dpi=None, **kwargs):
     traj : Trajectory
     kind : str
         One of :data:`KINDS`: ``"omega"``, ``"invariants"``, ``"polhode"``,
-        ``"gibbs"``, ``"attitude"``.
+        ``"gibbs"``, ``"attitude"``, ``"apex"``.
     out : str or path, optional
         File to write; the format is given by the extension (``.png``,
         ``.svg``, ``.pdf``). Written atomically.

@@ -99,13 +99,40 @@ def _load_toml(path: str) -> dict:
                          "a TOML file must be UTF-8") from None
 
 
+def _option_kind(annotation) -> str:
+    """The TOML/flag kind of a method option from its dataclass annotation ("float | None" -> "number")."""
+    text = str(annotation)
+    if "float" in text:
+        return "number"
+    if "int" in text:
+        return "int"
+    if "bool" in text:
+        return "bool"
+    return "str"
+
+
+def _method_option_kinds() -> dict[str, str]:
+    """Every option of every registered method (read from their typed option dataclasses) with its kind."""
+    import dataclasses
+
+    from ..solvers import available_methods, get_method
+
+    kinds: dict[str, str] = {}
+    for name in available_methods():
+        for f in dataclasses.fields(get_method(name).Options):
+            kinds.setdefault(f.name, _option_kind(f.type))
+    return kinds
+
+
+#: the options of the methods, from their dataclasses (``ep.solvers.TaylorOptions`` ...): flags and TOML keys
+METHOD_OPTIONS = _method_option_kinds()
+
 #: what each TOML key of ``simulate`` holds (checked when the file is read; nothing is coerced)
 _TOML_KINDS = {
     "body": {"inertia": "inertia", "masses": "numbers", "positions": "points", "name": "str"},
     "initial": {"omega": "numbers", "m": "numbers", "quaternion": "numbers", "gibbs": "numbers"},
     "time": {"t_end": "number", "samples": "int"},
-    "method": {"name": "str", "tol": "number", "dt": "number", "scheme": "str", "order": "int",
-               "integrator": "str", "rtol": "number", "atol": "number"},
+    "method": {"name": "str", **METHOD_OPTIONS},
     "output": {"file": "str", "json": "bool"},
     "torque": {"gravity": "numbers", "mass": "number", "center_of_mass": "numbers", "gravity_gradient": "number",
                "body_torque": "numbers", "space_torque": "numbers"},
@@ -200,9 +227,7 @@ _FLAGS = {
     "time.t_end": "--t-end",
     "time.samples": "--samples",
     "method.name": "--method",
-    "method.tol": "--tol",
-    "method.dt": "--dt",
-    "method.scheme": "--scheme",
+    **{f"method.{k}": "--" + k.replace("_", "-") for k in METHOD_OPTIONS},
     "output.file": "--out",
     "torque.gravity": "--gravity",
     "torque.mass": "--mass",
@@ -319,23 +344,48 @@ def _build_torques(cfg, name=None) -> list:
     return torques
 
 
-def _method_options(cfg, name=None) -> dict:
+def _method_options(cfg, name=None, method: str | None = None) -> dict:
+    """The method options given as flags or in ``[method]``, checked against the method's option dataclass.
+
+    Values are converted by the option's kind (numbers, integers, names); the
+    dataclass validates them (its errors name the option). An option of
+    another method is an error that lists the chosen method's options.
+    """
+    import dataclasses
+
+    from ..solvers import get_method
+
     name = name or _namer({})
+    allowed = None
+    if method is not None:
+        allowed = {f.name for f in dataclasses.fields(get_method(method).Options)}
     opts = {}
-    for key in ("tol", "dt", "rtol", "atol"):
+    for key, kind in METHOD_OPTIONS.items():
         k = f"method.{key}"
-        if cfg.get(k) is not None:
+        if cfg.get(k) is None:
+            continue
+        value = cfg[k]
+        if kind == "number":
             try:
-                opts[key] = float(cfg[k])
+                value = float(value)
             except (TypeError, ValueError):
                 raise UsageError(f"{name(k)}: {cfg[k]!r} is not a number") from None
-            if not (math.isfinite(opts[key]) and opts[key] > 0):
+            if key in ("tol", "dt", "rtol", "atol") and not (math.isfinite(value) and value > 0):
                 raise UsageError(f"{name(k)} must be a positive number, got {cfg[k]!r}")
-    for key in ("scheme", "integrator"):
-        if cfg.get(f"method.{key}") is not None:
-            opts[key] = str(cfg[f"method.{key}"])
-    if cfg.get("method.order") is not None:
-        opts["order"] = cfg["method.order"]  # an int: checked when the file was read
+            if not math.isfinite(value):
+                raise UsageError(f"{name(k)} must be a finite number, got {cfg[k]!r}")
+        elif kind == "int":
+            if isinstance(value, str):
+                try:
+                    value = int(value)
+                except ValueError:
+                    raise UsageError(f"{name(k)}: {cfg[k]!r} is not an integer") from None
+        else:
+            value = str(value)
+        if allowed is not None and key not in allowed:
+            have = ", ".join(_FLAGS[f"method.{a}"] for a in sorted(allowed)) or "none"
+            raise UsageError(f"{name(k)} is not an option of method {method!r} (its options: {have})")
+        opts[key] = value
     return opts
 
 
@@ -427,8 +477,8 @@ def cmd_simulate(args) -> int:
     given = {key: getattr(args, attr) for attr, key in (
         ("inertia", "body.inertia"), ("omega", "initial.omega"), ("m", "initial.m"),
         ("quaternion", "initial.quaternion"), ("gibbs", "initial.gibbs"), ("t_end", "time.t_end"),
-        ("samples", "time.samples"), ("method", "method.name"), ("tol", "method.tol"), ("dt", "method.dt"),
-        ("scheme", "method.scheme"), ("out", "output.file"),
+        ("samples", "time.samples"), ("method", "method.name"),
+        *((opt, f"method.{opt}") for opt in METHOD_OPTIONS), ("out", "output.file"),
         ("gravity", "torque.gravity"), ("mass", "torque.mass"), ("com", "torque.center_of_mass"),
         ("gravity_gradient", "torque.gravity_gradient"), ("body_torque", "torque.body_torque"),
         ("space_torque", "torque.space_torque"),
@@ -501,7 +551,7 @@ def cmd_simulate(args) -> int:
     if method not in available_methods():
         raise UsageError(f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}")
     check_supported(method, model)  # UnsupportedModelError (one line, exit 2) names the methods that can
-    opts = _method_options(cfg, name)
+    opts = _method_options(cfg, name, method)
     out = cfg.get("output.file")
     _check_file_name(out, name("output.file"))
     as_json = bool(args.json or cfg.get("output.json", False))
@@ -705,11 +755,12 @@ def cmd_demo(args) -> int:
 # ---------------------------------------------------------------------------
 def build_parser() -> argparse.ArgumentParser:
     from .. import __version__
+    from ..solvers import available_methods, get_method
 
     p = _Parser(
         prog="eulerpoisson",
-        description="The free rigid body in the Gibbs rotation vector n = k tan(alpha/2): "
-        "exact motion, integrators, the paper's audit, files and pictures.",
+        description="Rigid-body rotation, free (exact, in the Gibbs rotation vector n = k tan(alpha/2)) and "
+        "under torque: solvers, the paper's audit, files and pictures.",
         epilog="Run 'eulerpoisson COMMAND --help' for a command's options and examples.",
     )
     p.add_argument("--version", action="version", version=f"eulerpoisson {__version__}")
@@ -753,9 +804,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--t-end", dest="t_end", help="final time T >= 0")
     s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
     s.add_argument("--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)")
-    s.add_argument("--tol", help="tolerance for adaptive methods")
-    s.add_argument("--dt", help="step size for fixed-step methods")
-    s.add_argument("--scheme", help="scheme of the symplectic method (gauss2, gauss4, gauss6, ...)")
+    for opt in METHOD_OPTIONS:  # every option of every method, read from the option dataclasses
+        owners = "; ".join(f"{m}: default {get_method(m).options[opt]}" for m in available_methods()
+                           if opt in get_method(m).options)
+        s.add_argument("--" + opt.replace("_", "-"), dest=opt, metavar=opt.upper(),
+                       help=f"method option {opt} ({owners})")
     s.add_argument("--com", metavar="CX,CY,CZ",
                    help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)")
     s.add_argument("--mass", metavar="M", help="heavy top: mass M > 0 (default 1; needs --com)")
@@ -849,6 +902,8 @@ def build_parser() -> argparse.ArgumentParser:
 # ---------------------------------------------------------------------------
 def _value_options(parser: argparse.ArgumentParser) -> tuple[set[str], set[str]]:
     """Long options that take a value, and all option strings, of ``parser`` and its subcommands."""
+    from ..solvers import available_methods, get_method
+
     takes, every = set(), set()
     stack = [parser]
     while stack:

@@ -58,6 +58,38 @@ Write :math:`s = 1+\mathbf n^2`, :math:`N = [\mathbf n]_\times`,
   survives: the geodesics are reparametrized straight lines (gnomonic chart of
   :math:`S^3`).
 
+With a potential (the heavy top, the gravity gradient)
+------------------------------------------------------
+``formulation(name, body, torque=...)`` adds a conservative torque
+(:class:`~eulerpoisson.torques.Gravity`,
+:class:`~eulerpoisson.torques.GravityGradient`, any
+:class:`~eulerpoisson.torques.Torque` with ``conservative = True`` and a
+:meth:`~eulerpoisson.torques.Torque.potential`): :math:`H = H_0 + U(t, R)`
+with the *same* Poisson tensor. Its body-frame torque is minus the body-frame
+gradient of :math:`U`: along :math:`\delta R = R[\delta\boldsymbol\theta]_\times`,
+:math:`\delta U = -\boldsymbol\tau\cdot\delta\boldsymbol\theta`. In the Gibbs
+chart :math:`\delta\boldsymbol\theta = 2A^T\delta\mathbf n` (eq. 1.11), so
+
+.. math::
+    \frac{\partial U}{\partial\mathbf n} = -2A(\mathbf n)\boldsymbol\tau,\qquad
+    \dot{\boldsymbol\pi} = -\frac{\partial H_0}{\partial\mathbf n} + 2A\boldsymbol\tau,
+
+(:func:`gibbs_potential_gradient`), consistent with Euler's equations since
+:math:`\mathbf M = \tfrac12\tilde A\boldsymbol\pi` gains
+:math:`\tfrac12\tilde A(2A\boldsymbol\tau) = \boldsymbol\tau`. Pushed to the
+other charts with the brackets above: :math:`I\dot{\boldsymbol\Omega}` gains
+:math:`\boldsymbol\tau` in :math:`(R, \boldsymbol\Omega)` and
+:math:`(\mathbf n, \boldsymbol\Omega)`; :math:`\dot{\mathbf m}` gains
+:math:`-\tfrac12\tilde A^T\partial_{\mathbf n}U = \tilde A^TA\boldsymbol\tau = R\boldsymbol\tau`
+in :math:`(\mathbf n, \mathbf m)` (:math:`\tilde A^TA = A\tilde A^T` since
+:math:`[\mathbf n]_\times` and :math:`\mathbf n\mathbf n^T` commute); and
+:math:`\ddot{\mathbf n}` gains :math:`-G^{-1}\partial_{\mathbf n}U = \tfrac12\tilde A^TI^{-1}\boldsymbol\tau`
+in :math:`(\mathbf n, \dot{\mathbf n})` (Euler-Lagrange equations of
+:math:`L = \tfrac12\dot{\mathbf n}^TG\dot{\mathbf n} - U`). A
+time-dependent potential (the gravity gradient) makes the vector field depend
+on the time: ``vector_field(state, t)``, ``rhs(t, y)``. The symbolic
+derivation from the Lagrangian is :func:`eulerpoisson.paper.heavy_top.derive_heavy_top`.
+
 Where the printed paper differs (each checked numerically in the tests)
 -----------------------------------------------------------------------
 * Eq. 1.12: :math:`\tilde A_{ij}` has :math:`n_in_j`, not :math:`n_jn_j`.
@@ -112,7 +144,8 @@ from ..attitude.core import (
     skew,
 )
 from .body import RigidBody
-from ..errors import InvalidInputError, SingularChartError
+from .torques import Gravity, GravityGradient, Torque, as_torques
+from ..errors import InvalidInputError, SingularChartError, UnsupportedModelError
 
 __all__ = [
     "Formulation",
@@ -123,6 +156,7 @@ __all__ = [
     "Geodesic",
     "FORMULATIONS",
     "formulation",
+    "gibbs_potential_gradient",
     # Lagrangian side
     "metric_derivative",
     "christoffel",
@@ -472,7 +506,90 @@ def _as_body(body) -> RigidBody:
         return body
     if isinstance(body, Formulation):
         return body.body
+    from .equations import Model
+
+    if isinstance(body, Model):
+        return body.body
     return RigidBody(body)
+
+
+#: what ``torque=`` of the formulations accepts (for the error messages)
+_ACCEPTED = (
+    "None (the free body), or conservative torques: eulerpoisson.torques.Gravity, "
+    "eulerpoisson.torques.GravityGradient (or any Torque with conservative = True and a "
+    "potential), or a list of them"
+)
+
+
+def _potential_torques(body, torque, where: str) -> tuple:
+    """The conservative torques of ``torque=`` (and of a Model given as ``body``) as a tuple."""
+    from .equations import Model
+
+    if isinstance(body, Model):
+        if torque is not None:
+            raise TypeError(f"{where}: give the torque either in the Model or as torque=, not both")
+        torque = list(body.torques) or None
+    elif isinstance(body, Formulation) and torque is None:
+        torque = list(body.torques) or None
+    try:
+        torques = as_torques(torque)
+    except TypeError as exc:
+        raise TypeError(f"{where}: torque must be {_ACCEPTED}; got {torque!r}") from exc
+    for tq in torques:
+        if not (isinstance(tq, Torque) and tq.conservative and not tq.depends_on_omega):
+            raise UnsupportedModelError(
+                f"{where}: torque {tq!r} derives from no potential U(t, R), and the formulations are "
+                f"Hamiltonian (H = H0 + U); torque must be {_ACCEPTED}. For non-conservative torques use "
+                f"eulerpoisson.solve(..., torque=..., method='rk' or 'taylor')"
+            )
+    return torques
+
+
+def gibbs_potential_gradient(n, tau) -> np.ndarray:
+    r"""Gradient :math:`\partial U/\partial\mathbf n` of a potential from its body-frame torque.
+
+    A potential :math:`U(R)` whose torque is :math:`\boldsymbol\tau`
+    (:math:`\delta U = -\boldsymbol\tau\cdot\delta\boldsymbol\theta` for
+    :math:`\delta R = R[\delta\boldsymbol\theta]_\times`) has, in the Gibbs
+    chart where :math:`\delta\boldsymbol\theta = 2A^T(\mathbf n)\delta\mathbf n`
+    (eq. 1.11),
+
+    .. math::
+        \frac{\partial U}{\partial\mathbf n} = -2A(\mathbf n)\boldsymbol\tau
+        = -\frac{2}{1+\mathbf n^2}\left(\boldsymbol\tau + \mathbf n\times\boldsymbol\tau\right).
+
+    Parameters
+    ----------
+    n : array_like, shape (..., 3)
+        Gibbs vectors.
+    tau : array_like, shape (..., 3)
+        Body-frame torques :math:`\boldsymbol\tau(R(\mathbf n))` (broadcast against ``n``).
+
+    Returns
+    -------
+    ndarray, shape (..., 3)
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong trailing shape or non-finite values.
+
+    References
+    ----------
+    Paper eq. 1.9, 1.11, 1.12 (:math:`A`), 1.15-1.16 (the canonical equations
+    it enters: :math:`\dot{\boldsymbol\pi} = -\partial H_0/\partial\mathbf n - \partial U/\partial\mathbf n`).
+    """
+    n = as_float_array(n, "n", (3,))
+    tau = as_float_array(tau, "tau", (3,))
+    return -2.0 * _mvec(conversion_matrix(n), tau)
+
+
+def _add_block(out, sl, extra):
+    """``out`` (..., d) with ``extra`` (..., k) added to ``out[..., sl]``, broadcasting both."""
+    shape = np.broadcast_shapes(out.shape, extra.shape[:-1] + out.shape[-1:])
+    out = np.broadcast_to(out, shape).copy()
+    out[..., sl] += extra
+    return out
 
 
 # ---------------------------------------------------------------------------
@@ -696,10 +813,26 @@ class Formulation:
 
     Parameters
     ----------
-    body : RigidBody or array_like
+    body : RigidBody, Model or array_like
         The body, or its principal moments (3,) or inertia tensor (3, 3)
         (any symmetric positive-definite tensor obeying the triangle
-        inequality).
+        inequality), or a :class:`~eulerpoisson.Model` (its body and torques).
+    torque : Torque or list of Torque, optional
+        Conservative torques (:class:`~eulerpoisson.torques.Gravity`,
+        :class:`~eulerpoisson.torques.GravityGradient`): the Hamiltonian
+        becomes :math:`H_0 + U(t, R)` and the vector field gains the torque
+        (see the module docstring); the Poisson tensor is unchanged. None:
+        the free body. For a heavy top the inertia is about the fixed point.
+
+    Raises
+    ------
+    UnsupportedModelError
+        (a ``ValueError``) A torque that derives from no potential
+        (``BodyTorque``, ``SpaceTorque``, a callable).
+    TypeError
+        A ``torque`` that is not a torque, or a Model together with ``torque``.
+    InvalidInputError
+        Torque parameters whose batch shape does not broadcast with the body's.
 
     Attributes
     ----------
@@ -719,6 +852,8 @@ class Formulation:
         Rank of the Poisson tensor (``d`` when nondegenerate).
     equations : dict of str to str
         Paper equation numbers of each ingredient.
+    torques : tuple of Torque
+        The conservative torques (empty for the free body).
 
     Notes
     -----
@@ -738,13 +873,110 @@ class Formulation:
     rank: int = 0
     equations: dict = {}
 
-    def __init__(self, body):
+    def __init__(self, body, torque=None):
+        self.torques = _potential_torques(body, torque, f"the {self.name!r} formulation")
         self.body = _as_body(body)
         self._I = self.body.inertia
         self._Iinv = self.body.inertia_inv
         self._Icf = _cf2(self._I)
         self._Iinvcf = _cf2(self._Iinv)
-        self._bshape = self.body.batch_shape
+        shapes = [self.body.batch_shape] + [tq.batch_shape for tq in self.torques]
+        try:
+            self._bshape = np.broadcast_shapes(*shapes)
+        except ValueError:
+            desc = ", ".join(f"{type(tq).__name__} {tq.batch_shape}" for tq in self.torques)
+            raise InvalidInputError(
+                f"the {self.name!r} formulation: the torques' batch shapes ({desc}) do not broadcast with "
+                f"the body's {self.body.batch_shape}"
+            ) from None
+
+    @property
+    def is_free(self) -> bool:
+        """True for the free body (no torque)."""
+        return not self.torques
+
+    @property
+    def time_dependent(self) -> bool:
+        """True when the potential depends explicitly on the time (the gravity gradient)."""
+        return any(tq.time_dependent for tq in self.torques)
+
+    # -- the potential ------------------------------------------------------
+    @staticmethod
+    def _time(t):
+        return as_float_array(t, "t")
+
+    def _torque_at(self, t, R):
+        """Body-frame torque of the potential at the attitudes R (..., 3, 3), (..., 3)."""
+        tau = np.zeros(R.shape[:-2] + (3,))
+        w = np.zeros(R.shape[:-2] + (3,))
+        for tq in self.torques:
+            tau = tau + np.asarray(tq.evaluate(t, R, w, self._I), dtype=float)
+        return tau
+
+    def _potential_at(self, t, R):
+        """Potential :math:`U(t, R)` summed over the torques, (...)."""
+        U = np.zeros(R.shape[:-2])
+        for tq in self.torques:
+            U = U + np.asarray(tq.potential(t, R, self._I), dtype=float)
+        return U
+
+    def potential(self, state, t=0.0) -> np.ndarray:
+        r"""Potential energy :math:`U(t, R)` of the torques, shape (...) (zero for the free body).
+
+        Parameters
+        ----------
+        state : array_like, shape (..., d)
+        t : float or array_like, shape (...)
+            Time (only the gravity gradient depends on it).
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong trailing shape or non-finite values of ``state`` or ``t``.
+        """
+        x = self._check(state)
+        t = self._time(t)
+        shape = np.broadcast_shapes(self._batch(x), t.shape)
+        if not self.torques:
+            return np.zeros(shape)
+        return np.broadcast_to(self._potential_at(t, self.matrix(x)), shape).copy()
+
+    def torque(self, state, t=0.0) -> np.ndarray:
+        r"""Body-frame torque :math:`\boldsymbol\tau(t, R)` of the potential, shape (..., 3).
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong trailing shape or non-finite values of ``state`` or ``t``.
+        """
+        x = self._check(state)
+        t = self._time(t)
+        shape = np.broadcast_shapes(self._batch(x), t.shape) + (3,)
+        if not self.torques:
+            return np.zeros(shape)
+        return np.broadcast_to(self._torque_at(t, self.matrix(x)), shape).copy()
+
+    def _with_potential(self, H0, x, t):
+        if not self.torques:
+            return H0
+        t = self._time(t)
+        U = self._potential_at(t, self.matrix(x))
+        return np.asarray(H0 + U)
+
+    def _gravity_direction(self):
+        """Common unit direction of ``g`` when every torque is a Gravity with parallel ``g``; else None."""
+        if not self.torques or not all(isinstance(tq, Gravity) for tq in self.torques):
+            return None
+        ghat = None
+        for tq in self.torques:
+            norm = np.sqrt(np.sum(tq.g * tq.g, -1))
+            if np.any(norm == 0):
+                return None
+            d = tq.g / norm[..., None]
+            if ghat is not None and not np.allclose(d, ghat, rtol=0.0, atol=1e-14):
+                return None
+            ghat = d
+        return ghat
 
     # -- validation and layout ---------------------------------------------
     def _check(self, state, what="state"):
@@ -785,8 +1017,11 @@ class Formulation:
         return np.concatenate([np.broadcast_to(f, shape + f.shape[-1:]) for f in flat], -1)
 
     # -- dynamics -------------------------------------------------------------
-    def vector_field(self, state) -> np.ndarray:
-        """Right-hand side :math:`\\dot z = P(z)\\nabla H(z)`, shape (..., d).
+    def vector_field(self, state, t=0.0) -> np.ndarray:
+        """Right-hand side :math:`\\dot z = P(z)\\nabla H(z, t)`, shape (..., d).
+
+        ``t`` (float or array broadcast against the batch) matters only for a
+        time-dependent potential (the gravity gradient).
 
         Raises
         ------
@@ -796,11 +1031,11 @@ class Formulation:
         raise NotImplementedError
 
     def rhs(self, t, y) -> np.ndarray:
-        """``vector_field(y)`` with scipy's ``fun(t, y)`` signature (autonomous)."""
-        return self.vector_field(y)
+        """``vector_field(y, t)`` with scipy's ``fun(t, y)`` signature."""
+        return self.vector_field(y, t)
 
-    def hamiltonian(self, state) -> np.ndarray:
-        """Hamiltonian (the kinetic energy) in these variables, shape (...)."""
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
+        """Hamiltonian in these variables, :math:`H_0 + U(t, R)` (the kinetic energy plus the potential), shape (...)."""
         raise NotImplementedError
 
     def poisson_tensor(self, state) -> np.ndarray:
@@ -816,12 +1051,27 @@ class Formulation:
         x = self._check(state)
         return np.zeros(self._batch(x) + (0,))
 
-    def integrals(self, state) -> dict:
-        r"""First integrals: ``H`` (...), ``m`` (..., 3), ``m2`` (...), ``m3`` (...).
+    def integrals(self, state, t=0.0) -> dict:
+        r"""First integrals.
 
+        Free body: ``H`` (...), ``m`` (..., 3), ``m2`` (...), ``m3`` (...).
         ``m`` is the spatial angular momentum :math:`R I\boldsymbol\Omega`,
         ``m2`` :math:`= \mathbf m^2`, ``m3`` its third component; ``H``,
         ``m2``, ``m3`` are in involution (paper eq. 1.19, 1.23).
+
+        With a potential: ``H`` :math:`= H_0 + U(t, R)` (conserved when no
+        torque depends on the time); for gravity along one direction
+        :math:`\hat{\mathbf g}` also ``m_vertical`` :math:`= \mathbf m\cdot\hat{\mathbf g}`
+        (the space torque :math:`(R\mathbf c)\times\mu\mathbf g` is
+        horizontal); for one gravity gradient the Jacobi integral ``jacobi``
+        :math:`= H - \nu m_3` (:math:`U` depends on :math:`t` only through a
+        rotation by :math:`\nu t` about :math:`\mathbf e_3`, generated by :math:`m_3`).
+
+        Parameters
+        ----------
+        state : array_like, shape (..., d)
+        t : float or array_like, shape (...)
+            Time (for a time-dependent potential).
 
         Raises
         ------
@@ -830,7 +1080,16 @@ class Formulation:
         """
         x = self._check(state)
         m = self.spatial_momentum(x)
-        return {"H": self.hamiltonian(x), "m": m, "m2": np.sum(m * m, -1), "m3": m[..., 2]}
+        H = self.hamiltonian(x, t)
+        if not self.torques:
+            return {"H": H, "m": m, "m2": np.sum(m * m, -1), "m3": m[..., 2]}
+        out = {"H": H}
+        ghat = self._gravity_direction()
+        if ghat is not None:
+            out["m_vertical"] = np.sum(m * ghat, -1)
+        if len(self.torques) == 1 and isinstance(self.torques[0], GravityGradient):
+            out["jacobi"] = H - self.torques[0].mean_motion * m[..., 2]
+        return out
 
     # -- conversions --------------------------------------------------------
     def to_common(self, state):
@@ -882,7 +1141,8 @@ class Formulation:
         return _mvec(self.matrix(state), self.body_momentum(state))
 
     def __repr__(self) -> str:
-        return f"{type(self).__name__}(name={self.name!r}, dimension={self.dimension}, body={self.body!r})"
+        tq = f", torque={list(self.torques)!r}" if self.torques else ""
+        return f"{type(self).__name__}(name={self.name!r}, dimension={self.dimension}, body={self.body!r}{tq})"
 
 
 #: largest |n| at which the Gibbs formulations evaluate their formulas (powers up to
@@ -943,6 +1203,27 @@ class _GibbsFormulation(Formulation):
         x = self._check(state)
         return x, _cf(x[..., 0:3]), _cf(x[..., 3:6])
 
+    def _tau_n(self, x, t):
+        """Body-frame torque at R(n) of the states x, (..., 3)."""
+        return self._torque_at(self._time(t), matrix_from_gibbs(x[..., 0:3]))
+
+    def potential_gradient(self, state, t=0.0) -> np.ndarray:
+        r"""Closed-form :math:`\partial U/\partial\mathbf n = -2A(\mathbf n)\boldsymbol\tau`, shape (..., 3).
+
+        See :func:`gibbs_potential_gradient`; zero for the free body.
+
+        Raises
+        ------
+        InvalidInputError
+            Wrong trailing shape or non-finite values of ``state`` or ``t``.
+        """
+        x = self._check(state)
+        shape = np.broadcast_shapes(self._batch(x), self._time(t).shape) + (3,)
+        if not self.torques:
+            return np.zeros(shape)
+        g = -2.0 * _mvec(conversion_matrix(x[..., 0:3]), self._tau_n(x, t))
+        return np.broadcast_to(g, shape).copy()
+
     def _common_in(self, q, omega):
         n = gibbs_from_quaternion(q)
         _check_gibbs_norm(n, f"q for the {self.name!r} formulation")
@@ -994,14 +1275,19 @@ class EulerPoisson(Formulation):
         R = x[..., :9].reshape(x.shape[:-1] + (3, 3))
         return x, R, x[..., 9:12]
 
-    def vector_field(self, state) -> np.ndarray:
+    def vector_field(self, state, t=0.0) -> np.ndarray:
         x, R, W = self._split(state)
         Rd, Wd = euler_poisson_rhs(_cf2(R), _cf(W), self._Icf, self._Iinvcf)
-        return _stack(Rd[0] + Rd[1] + Rd[2] + Wd)
+        out = _stack(Rd[0] + Rd[1] + Rd[2] + Wd)
+        if self.torques:
+            tau = self._torque_at(self._time(t), R)
+            out = _add_block(out, slice(9, 12), _mvec(self._Iinv, tau))
+        return out
 
-    def hamiltonian(self, state) -> np.ndarray:
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
         x, R, W = self._split(state)
-        return np.broadcast_to(kinetic_energy(_cf(W), self._Icf), self._batch(x)).copy()
+        H = self._with_potential(kinetic_energy(_cf(W), self._Icf), x, t)
+        return np.broadcast_to(H, np.broadcast_shapes(self._batch(x), np.shape(H))).copy()
 
     def poisson_tensor(self, state) -> np.ndarray:
         x, R, W = self._split(state)
@@ -1056,7 +1342,14 @@ class Canonical(_GibbsFormulation):
 
     The vector field is the polynomial of :func:`canonical_rhs`
     (paper eq. 1.16 with :math:`\epsilon_{ijk}\pi_k` in place of the printed
-    :math:`\epsilon_{ijk}n_k`).
+    :math:`\epsilon_{ijk}n_k`). With a potential :math:`U(t, R)` (``torque=``),
+    :math:`H = H_0 + U(t, R(\mathbf n))` and
+
+    .. math:: \dot{\boldsymbol\pi} = -\frac{\partial H_0}{\partial\mathbf n}
+              - \frac{\partial U}{\partial\mathbf n}, \qquad
+              \frac{\partial U}{\partial\mathbf n} = -2A(\mathbf n)\boldsymbol\tau
+
+    (:meth:`potential_gradient`), with the canonical Poisson tensor.
     """
 
     name = "canonical"
@@ -1072,16 +1365,22 @@ class Canonical(_GibbsFormulation):
         "poisson_tensor": "1.15.1",
         "integrals": "1.15, 1.17, 1.19, 1.23",
         "momenta": "1.14",
+        "potential_gradient": "1.11-1.12 (dU/dn = -2 A tau)",
     }
 
-    def vector_field(self, state) -> np.ndarray:
+    def vector_field(self, state, t=0.0) -> np.ndarray:
         x, n, p = self._split(state)
         nd, pd = canonical_rhs(n, p, self._Iinvcf)
-        return _stack(nd + pd)
+        out = _stack(nd + pd)
+        if self.torques:
+            # pi-dot gains -dU/dn = 2 A tau
+            out = _add_block(out, slice(3, 6), 2.0 * _mvec(conversion_matrix(x[..., 0:3]), self._tau_n(x, t)))
+        return out
 
-    def hamiltonian(self, state) -> np.ndarray:
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
         x, n, p = self._split(state)
-        return np.broadcast_to(canonical_hamiltonian(n, p, self._Iinvcf), self._batch(x)).copy()
+        H = self._with_potential(canonical_hamiltonian(n, p, self._Iinvcf), x, t)
+        return np.broadcast_to(H, np.broadcast_shapes(self._batch(x), np.shape(H))).copy()
 
     def poisson_tensor(self, state) -> np.ndarray:
         x = self._check(state)
@@ -1142,14 +1441,20 @@ class Momentum(_GibbsFormulation):
         "integrals": "1.17, 1.19, 1.23",
     }
 
-    def vector_field(self, state) -> np.ndarray:
+    def vector_field(self, state, t=0.0) -> np.ndarray:
         x, n, m = self._split(state)
         nd, md = momentum_rhs(n, m, self._Iinvcf)
-        return _stack(nd + md)
+        out = _stack(nd + md)
+        if self.torques:
+            # m-dot gains the space-frame torque R tau = -1/2 Atilde^T dU/dn
+            R = matrix_from_gibbs(x[..., 0:3])
+            out = _add_block(out, slice(3, 6), _mvec(R, self._torque_at(self._time(t), R)))
+        return out
 
-    def hamiltonian(self, state) -> np.ndarray:
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
         x, n, m = self._split(state)
-        return np.broadcast_to(momentum_hamiltonian(n, m, self._Iinvcf), self._batch(x)).copy()
+        H = self._with_potential(momentum_hamiltonian(n, m, self._Iinvcf), x, t)
+        return np.broadcast_to(H, np.broadcast_shapes(self._batch(x), np.shape(H))).copy()
 
     def poisson_tensor(self, state) -> np.ndarray:
         x = self._check(state)
@@ -1211,14 +1516,18 @@ class Velocity(_GibbsFormulation):
         "momenta": "1.26",
     }
 
-    def vector_field(self, state) -> np.ndarray:
+    def vector_field(self, state, t=0.0) -> np.ndarray:
         x, n, W = self._split(state)
         nd, Wd = velocity_rhs(n, W, self._Icf, self._Iinvcf)
-        return _stack(nd + Wd)
+        out = _stack(nd + Wd)
+        if self.torques:
+            out = _add_block(out, slice(3, 6), _mvec(self._Iinv, self._tau_n(x, t)))
+        return out
 
-    def hamiltonian(self, state) -> np.ndarray:
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
         x, n, W = self._split(state)
-        return np.broadcast_to(kinetic_energy(W, self._Icf), self._batch(x)).copy()
+        H = self._with_potential(kinetic_energy(W, self._Icf), x, t)
+        return np.broadcast_to(H, np.broadcast_shapes(self._batch(x), np.shape(H))).copy()
 
     def poisson_tensor(self, state) -> np.ndarray:
         x = self._check(state)
@@ -1253,7 +1562,9 @@ class Geodesic(_GibbsFormulation):
     body motion (from :math:`R(\mathbf n_0)`).
 
     The "Hamiltonian" is the energy :math:`E = \tfrac12\dot{\mathbf n}^TG\dot{\mathbf n}`
-    (equal to :math:`L`). The Poisson tensor is the canonical one pulled
+    (equal to :math:`L`), plus :math:`U` with a potential (then
+    :math:`L = E - U` and the motion is no longer geodesic: :math:`\ddot{\mathbf n}`
+    gains :math:`-G^{-1}\partial U/\partial\mathbf n`). The Poisson tensor is the canonical one pulled
     back by :math:`\boldsymbol\pi = G(\mathbf n)\dot{\mathbf n}`:
 
     .. math::
@@ -1277,16 +1588,27 @@ class Geodesic(_GibbsFormulation):
         "integrals": "1.11, 1.24",
     }
 
-    def vector_field(self, state) -> np.ndarray:
+    def vector_field(self, state, t=0.0) -> np.ndarray:
         x, n, v = self._split(state)
         nd, a = geodesic_rhs(n, v, self._Icf, self._Iinvcf)
-        return _stack(nd + a)
+        out = _stack(nd + a)
+        if self.torques:
+            # Euler-Lagrange with L = E - U: nddot gains -G^{-1} dU/dn = 1/2 Atilde^T I^{-1} tau
+            K = _T(inverse_conversion_matrix(x[..., 0:3])) @ self._Iinv
+            out = _add_block(out, slice(3, 6), 0.5 * _mvec(K, self._tau_n(x, t)))
+        return out
 
-    def hamiltonian(self, state) -> np.ndarray:
+    def hamiltonian(self, state, t=0.0) -> np.ndarray:
         x, n, v = self._split(state)
-        return np.broadcast_to(geodesic_energy(n, v, self._Icf), self._batch(x)).copy()
+        H = self._with_potential(geodesic_energy(n, v, self._Icf), x, t)
+        return np.broadcast_to(H, np.broadcast_shapes(self._batch(x), np.shape(H))).copy()
 
-    lagrangian = hamiltonian
+    def lagrangian(self, state, t=0.0) -> np.ndarray:
+        r"""Lagrangian :math:`L = \tfrac12\dot{\mathbf n}^TG\dot{\mathbf n} - U(t, R(\mathbf n))` (eq. 1.13 with a potential), shape (...)."""
+        x, n, v = self._split(state)
+        E = geodesic_energy(n, v, self._Icf)
+        L = E - self._potential_at(self._time(t), self.matrix(x)) if self.torques else E
+        return np.broadcast_to(L, np.broadcast_shapes(self._batch(x), np.shape(L))).copy()
 
     def metric(self, state) -> np.ndarray:
         """:math:`G(\\mathbf n) = 4AIA^T`, (..., 3, 3)."""
@@ -1353,8 +1675,8 @@ _ALIASES = {
 }
 
 
-def formulation(name: str, body) -> Formulation:
-    """Construct a formulation by registry name.
+def formulation(name: str, body, torque=None) -> Formulation:
+    r"""Construct a formulation by registry name, for the free body or with a potential.
 
     Parameters
     ----------
@@ -1363,8 +1685,16 @@ def formulation(name: str, body) -> Formulation:
         ``'momentum'``, ``'velocity'``, ``'geodesic'``) or an alias
         (``'R-Omega'``, ``'n-pi'``, ``'n-m'``, ``'n-Omega'``, ``'n-ndot'``,
         ``'lagrangian'``, ``'noncanonical'``); case and ``_`` / ``-`` are ignored.
-    body : RigidBody or array_like
-        The body or its inertia (moments (3,) or tensor (3, 3)).
+    body : RigidBody, Model or array_like
+        The body or its inertia (moments (3,) or tensor (3, 3)), or a
+        :class:`~eulerpoisson.Model` (its body and torques).
+    torque : Torque or list of Torque, optional
+        Conservative torques (:class:`~eulerpoisson.torques.Gravity`,
+        :class:`~eulerpoisson.torques.GravityGradient`):
+        :math:`H = H_0 + U(t, R)`, the same Poisson tensor, and in the
+        canonical chart :math:`\dot{\boldsymbol\pi} = -\partial H_0/\partial\mathbf n
+        - \partial U/\partial\mathbf n` with :math:`\partial U/\partial\mathbf n
+        = -2A(\mathbf n)\boldsymbol\tau` (see the module docstring). None: the free body.
 
     Returns
     -------
@@ -1374,10 +1704,26 @@ def formulation(name: str, body) -> Formulation:
     ------
     InvalidInputError
         Unknown name.
+    UnsupportedModelError
+        (a ``ValueError``) A non-conservative torque (``BodyTorque``,
+        ``SpaceTorque``, a callable); the message names what is accepted.
     TypeError
-        ``name`` is not a string.
+        ``name`` is not a string; ``torque`` is not a torque.
     InvalidInertiaError
         Not a physical inertia tensor.
+
+    References
+    ----------
+    Paper eq. 1.9-1.16 (the canonical formulation the potential is added to).
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> top = ep.torques.Gravity(mass=1.0, center_of_mass=[0.0, 0.0, 0.1])
+    >>> f = ep.formulation("canonical", [1.0, 1.0, 0.5], torque=top)
+    >>> z = f.from_common([1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0])
+    >>> f.vector_field(z).shape
+    (6,)
     """
     if not isinstance(name, str):
         raise TypeError(f"formulation name must be a string, got {type(name).__name__} {name!r}")
@@ -1388,4 +1734,4 @@ def formulation(name: str, body) -> Formulation:
             f"unknown formulation {name!r}; expected one of {sorted(FORMULATIONS)} "
             f"or an alias {sorted(_ALIASES)}"
         )
-    return FORMULATIONS[key](body)
+    return FORMULATIONS[key](body, torque)

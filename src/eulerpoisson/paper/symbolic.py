@@ -23,6 +23,11 @@ two:
   \mathbf M)` computed from the canonical bracket (eq. 1.21, 1.28);
 * the Lie series :math:`z(t) = e^{tL_H} z_0` of eq. 1.23.1.
 
+The heavy top (:math:`L = \tfrac12\dot{\mathbf n}^TG\dot{\mathbf n} - U(\mathbf n)`,
+:math:`U = -\mu\,\mathbf g\cdot R(\mathbf n)\mathbf c`) is derived on top of
+this module in :mod:`eulerpoisson.paper.heavy_top`
+(:func:`~eulerpoisson.paper.heavy_top.derive_heavy_top`).
+
 The inertia tensor is either the general symmetric matrix with entries
 ``I11, I12, I13, I22, I23, I33`` (``inertia="general"``) or
 ``diag(I1, I2, I3)`` (``inertia="diagonal"``).

@@ -388,3 +388,9 @@ def test_observed_order_under_torque_matches_nominal(name):
         assert errs[0] > errs[1] > errs[2], errs
         a = np.log10(errs[0] / errs[2]) / 4
         assert 0.6 <= a <= 1.5, (name, errs)
+
+
+def test_exact_lagrange_refuses_times_beyond_float64_phase():
+    top = Gravity(1.0, [0, 0, 0.1])
+    with pytest.raises(InvalidInputError, match="exceeds 2\\^48"):
+        ep.solve([1, 1, 0.5], [1e20], omega0=[0, 0, 0], torque=top)  # a pendulum from rest: rate sqrt(mgl/A)

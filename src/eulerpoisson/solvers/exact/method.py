@@ -47,7 +47,7 @@ __all__ = ["Exact"]
 MAX_PHASE = 2.0**48
 
 
-def _check_phase_range(problem: Problem) -> None:
+def _check_phase_range(problem: Problem, speed=None) -> None:
     r"""Refuse times at which float64 no longer determines the phase of the motion.
 
     The frequencies of the motion (the elliptic :math:`\lambda` and the
@@ -61,13 +61,16 @@ def _check_phase_range(problem: Problem) -> None:
     Raises
     ------
     InvalidInputError
-        If :math:`|\boldsymbol\Omega_0||t| > 2^{48}` for some body and time.
+        If :math:`|\boldsymbol\Omega_0||t| > 2^{48}` for some body and time
+        (``speed`` replaces :math:`|\boldsymbol\Omega_0|` when given: a
+        heavy top's rate includes :math:`\sqrt{\mu g\ell/A}`).
     """
     from ...errors import InvalidInputError
 
     if problem.t.size == 0:
         return
-    speed = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1))
+    if speed is None:
+        speed = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1))
     tmax = float(np.max(np.abs(problem.t)))
     with np.errstate(over="ignore"):
         phase = speed * tmax
@@ -145,6 +148,9 @@ class Exact(Method):
         bshape = problem.batch_shape
         A, C, mass, ell, g, F = (np.broadcast_to(x, bshape + x.shape[len(problem.model.batch_shape):])
                                  for x in _lagrange_parameters(problem.model))
+        rate = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1)) + np.sqrt(
+            mass * np.sqrt(np.sum(g * g, axis=-1)) * np.abs(ell) / A)
+        _check_phase_range(problem, rate)
         qF = quaternion_from_rotation_matrix(F)
         q0 = qmul(problem.q0, qF)
         w0 = np.einsum("...ji,...j->...i", F, problem.omega0)

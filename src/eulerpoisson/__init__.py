@@ -5,12 +5,18 @@ formulations and its machine-checked audit, the exact (elliptic-function)
 motion, and geometric integrators.
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
 
-try:
-    __version__ = _version("eulerpoisson")
-except PackageNotFoundError:  # pragma: no cover - running from a source tree
-    __version__ = "0+unknown"
+
+def _package_version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("eulerpoisson")
+    except PackageNotFoundError:  # pragma: no cover - running from a source tree
+        return "0+unknown"
+
+
+__version__ = _package_version()
 
 from .attitude.core import Attitude
 from .model.body import RigidBody
@@ -47,3 +53,37 @@ __all__ = [
     "UnsupportedModelError",
     "MissingDependencyError",
 ]
+
+
+#: modules reachable as attributes (``ep.plots``, ``ep.analysis``...), imported on first use so that
+#: ``import eulerpoisson`` does not pay for matplotlib, sympy or dask
+_LAZY_MODULES = {
+    "analysis": ".analysis",
+    "attitude": ".attitude",
+    "plots": ".viz.plots",
+    "animate": ".viz.animate",
+    "audit": ".paper.audit",
+    "symbolic": ".paper.symbolic",
+    "heavy_top": ".paper.heavy_top",
+    "formulations": ".model.formulations",
+    "stream": ".io.stream",
+    "sweep": ".sweep",
+    "solvers": ".solvers",
+    "model": ".model",
+    "testing": ".testing",
+    "oracle": ".oracle",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY_MODULES:
+        import importlib
+
+        module = importlib.import_module(_LAZY_MODULES[name], __name__)
+        globals()[name] = module
+        return module
+    raise AttributeError(f"module 'eulerpoisson' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(__all__) | set(_LAZY_MODULES))

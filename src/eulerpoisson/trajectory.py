@@ -531,6 +531,107 @@ class Trajectory:
                 )
         return traj
 
+    # ------------------------------------------------------------------
+    # selecting and evaluating
+    # ------------------------------------------------------------------
+    def __getitem__(self, index) -> "Trajectory":
+        """The samples ``index`` (an int, a slice, an integer or boolean array) of the time axis.
+
+        ``len(tr)`` is the number of output times and ``tr[i]`` the trajectory
+        reduced to sample ``i`` (for every body of a batch); ``tr[::10]``
+        thins it. Select a time by value with :meth:`sel`, evaluate at any
+        time with ``tr(t)``.
+
+        Raises
+        ------
+        TypeError
+            A float or a tuple index.
+        IndexError
+            Out of range.
+        """
+        if isinstance(index, (tuple, float, np.floating, str)) or isinstance(index, (bool, np.bool_)):
+            raise TypeError(f"a trajectory is indexed by sample (int, slice or integer array), got {index!r}; "
+                            f"select by time with tr.sel(t=...) or evaluate with tr(t)")
+        idx = np.arange(self.t.shape[0])[index]
+        idx = np.atleast_1d(idx)
+        return Trajectory(self.t[idx], self.quaternion[..., idx, :], self.omega[..., idx, :], self.body,
+                          self.method, self.options, self.stats, torque=list(self.model.torques))
+
+    def sel(self, t, method: str | None = None) -> "Trajectory":
+        """The samples at the output times ``t`` (exact match, or ``method="nearest"``).
+
+        Parameters
+        ----------
+        t : float or array_like
+            Times to select.
+        method : {None, "nearest"}
+            None: every time must be one of the output times.
+
+        Raises
+        ------
+        KeyError
+            A time that is not an output time (with ``method=None``).
+        ValueError
+            An unknown ``method``; an empty trajectory.
+        """
+        want = np.atleast_1d(as_float_array(t, "t"))
+        if self.t.size == 0:
+            raise ValueError("sel() on a trajectory with no output times")
+        if method not in (None, "nearest"):
+            raise ValueError(f"sel(method=...) must be None or 'nearest', got {method!r}")
+        order = np.argsort(self.t, kind="stable")
+        ts = self.t[order]
+        pos = np.clip(np.searchsorted(ts, want), 0, ts.size - 1)
+        left = np.clip(pos - 1, 0, ts.size - 1)
+        pick = np.where(np.abs(ts[left] - want) < np.abs(ts[pos] - want), left, pos)
+        if method is None and np.any(ts[pick] != want):
+            bad = float(want[ts[pick] != want][0])
+            raise KeyError(f"t = {bad!r} is not an output time of this trajectory; use sel(t, method='nearest') "
+                           f"or evaluate it with tr({bad!r})")
+        return self[order[pick]]
+
+    def __call__(self, t, **options) -> "Trajectory":
+        r"""The motion at any times ``t``: recomputed from the first sample by the trajectory's method.
+
+        The closed form (``exact``) evaluates the same solution at the new
+        times; an integrator integrates again from ``t[0]`` with the same
+        options (its error is of the same size as the trajectory's own).
+        Time-dependent torques are continued at the right phase. ``options``
+        override the method's options.
+
+        Parameters
+        ----------
+        t : float or array_like, shape (T,)
+            Any times (before ``t[0]`` too).
+
+        Returns
+        -------
+        Trajectory
+
+        Raises
+        ------
+        InvalidInputError
+            An empty trajectory, or a method that is not known.
+        """
+        from .io.stream import solve_from
+        from .solvers import available_methods
+
+        if self.t.size == 0:
+            raise InvalidInputError("a trajectory with no output times cannot be evaluated: it has no state")
+        i0 = int(np.argmin(self.t))
+        method = self.method if self.method in available_methods() else ("exact" if self.model.is_free else "taylor")
+        opts = {**({} if method != self.method else self.options), **options}
+        times = np.atleast_1d(as_float_array(t, "t"))
+        return solve_from(self.model, times, float(self.t[i0]), self.quaternion[..., i0, :], self.omega[..., i0, :],
+                          method=method, **opts)
+
+    def plot(self, kind: str = "omega", **kwargs):
+        """A picture of the trajectory: :func:`eulerpoisson.viz.plots.plot` (``kind``: omega, invariants,
+        polhode, gibbs, attitude, apex); returns the matplotlib figure (or writes ``out=`` when given)."""
+        from .viz import plots
+
+        return plots.plot(self, kind, **kwargs)
+
     def __repr__(self) -> str:
         b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
         span = f"[{self.t.min():.6g}, {self.t.max():.6g}]" if self.t.size else "[]"

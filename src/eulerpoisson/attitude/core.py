@@ -76,6 +76,7 @@ from ..errors import InvalidInputError, SingularChartError
 
 __all__ = [
     "Attitude",
+    "UNIT_QUATERNION_TOLERANCE",
     "skew",
     "unskew",
     "quaternion_multiply",
@@ -128,6 +129,10 @@ _CONJ = np.array([1.0, -1.0, -1.0, -1.0])
 #: cosine) of the half middle angle is below this fraction of the other; the
 #: rotation error introduced by zeroing the third angle is at most about
 #: twice this value.
+#: largest | |q| - 1 | accepted where a unit quaternion is required (a float32-rounded unit quaternion is
+#: off by about 3e-8); inputs within it are renormalized, inputs beyond it are refused
+UNIT_QUATERNION_TOLERANCE = 1e-6
+
 EULER_GIMBAL_TOL = 1e-14
 
 

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import EulerPoissonError, MissingDependencyError
 
 __all__ = ["main"]
@@ -521,9 +522,9 @@ def cmd_simulate(args) -> int:
     if "initial.quaternion" in cfg:
         q0 = np.array(_floats(cfg["initial.quaternion"], name("initial.quaternion"), (4,)))
         nrm = float(np.linalg.norm(q0))
-        if abs(nrm - 1.0) > 1e-6:
+        if abs(nrm - 1.0) > UNIT_QUATERNION_TOLERANCE:
             raise UsageError(
-                f"{name('initial.quaternion')} must be a unit quaternion w,x,y,z (norm 1 within 1e-6); its norm is {nrm:.9g}"
+                f"{name('initial.quaternion')} must be a unit quaternion w,x,y,z (norm 1 within {UNIT_QUATERNION_TOLERANCE:g}); its norm is {nrm:.9g}"
             )
         q0 = q0 / nrm
     elif "initial.gibbs" in cfg:

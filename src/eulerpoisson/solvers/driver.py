@@ -25,7 +25,7 @@ from .registry import MethodOptions, check_supported, get_method
 __all__ = ["solve"]
 
 
-def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method: str = "exact", **options):
+def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None, method="exact", **options):
     r"""Motion of rigid bodies, free or under torque, at the output times ``t``.
 
     Parameters
@@ -42,9 +42,13 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
     m0 : array_like, shape (..., 3), optional
         Initial spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`.
         Exactly one of ``omega0`` and ``m0``.
-    attitude0 : Attitude or array_like, shape (..., 4), optional
-        Initial attitude (unit quaternion); the identity by default, as for
-        the paper's trajectories through the unit of SO(3) (eq. 1.2).
+    attitude0 : Attitude, scipy Rotation or array_like, shape (..., 4), optional
+        Initial attitude (unit quaternions w, x, y, z, norm 1 within
+        :data:`~eulerpoisson.attitude.UNIT_QUATERNION_TOLERANCE`); the identity by
+        default, as for the paper's trajectories through the unit of SO(3) (eq. 1.2).
+    gibbs0 : array_like, shape (..., 3), optional
+        Initial attitude as the Gibbs vector n = k tan(alpha/2) (eq. 1.8),
+        instead of ``attitude0``.
     torque : Torque, callable, list of them, or None
         Torques (:mod:`eulerpoisson.torques`: ``Gravity``, ``GravityGradient``,
         ``BodyTorque``, ``SpaceTorque``; a callable ``torque(t, q, omega) ->
@@ -67,7 +71,10 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
     Raises
     ------
     TypeError
-        Neither or both of ``omega0``/``m0``; an unknown option.
+        Neither or both of ``omega0``/``m0``; both ``attitude0`` and
+        ``gibbs0``; an unknown keyword (named as an argument of ``solve``
+        when no method has it, with the closest name) or an option of
+        another method.
     InvalidInputError
         Unknown method, bad shapes, NaN/inf, a non-unit quaternion.
     UnsupportedModelError
@@ -89,12 +96,14 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
     """
     if isinstance(method, MethodOptions):
         cls = get_method(method.method)
+        _check_keywords(cls, options)
         m = cls(method, **options)
         method = method.method
     else:
         cls = get_method(method)
+        _check_keywords(cls, options)
         m = cls(**options)
-    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, torque=torque)
+    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, gibbs0=gibbs0, torque=torque)
     check_supported(method, problem.model)
     if not cls.negative_times and np.any(problem.t < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
@@ -114,3 +123,31 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, torque=None, method:
     )
 
 
+
+
+#: the keyword arguments of :func:`solve` itself
+_SOLVE_ARGUMENTS = ("omega0", "m0", "attitude0", "gibbs0", "torque", "method")
+
+
+def _check_keywords(cls, options) -> None:
+    """An unknown keyword is an error of ``solve`` (with the closest name), an option of another method is named so."""
+    import difflib
+
+    from .registry import available_methods
+
+    own = set(cls.options)
+    every = {name: set(get_method(name).options) for name in available_methods()}
+    for key in options:
+        if key in own:
+            continue
+        owners = sorted(name for name, opts in every.items() if key in opts)
+        if owners:
+            have = ", ".join(sorted(own)) or "none"
+            raise TypeError(f"method {cls.name!r} has no option {key!r} (an option of {', '.join(owners)}); "
+                            f"its options: {have}")
+        known = list(_SOLVE_ARGUMENTS) + sorted(own)
+        close = difflib.get_close_matches(key, known + sorted(set().union(*every.values())), n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise TypeError(f"solve() got an unexpected keyword argument {key!r}{hint}; arguments: "
+                        f"{', '.join(_SOLVE_ARGUMENTS)}, and the options of method {cls.name!r}: "
+                        f"{', '.join(sorted(own)) or 'none'}")

@@ -17,7 +17,7 @@ from ..model.equations import Model, as_model
 from ..numerics.quaternion import qmul
 from ..util.validate import as_float_array
 
-__all__ = ["Problem", "make_problem", "compose_initial"]
+__all__ = ["Problem", "make_problem", "initial_quaternion", "compose_initial"]
 
 
 @dataclass(frozen=True)
@@ -77,7 +77,46 @@ def _as_times(t) -> np.ndarray:
     return np.atleast_1d(ta)
 
 
-def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, torque=None) -> Problem:
+def initial_quaternion(attitude0=None, gibbs0=None) -> np.ndarray:
+    """The initial attitude as unit quaternions (..., 4) from what :func:`solve` accepts.
+
+    ``attitude0``: an :class:`~eulerpoisson.Attitude`, a scipy ``Rotation`` or
+    unit quaternions (w, x, y, z) (norm 1 within
+    :data:`~eulerpoisson.attitude.UNIT_QUATERNION_TOLERANCE`, renormalized);
+    ``gibbs0``: Gibbs vectors n = k tan(alpha/2). At most one of them; none:
+    the identity.
+
+    Raises
+    ------
+    TypeError
+        Both given, or an object that is not an attitude.
+    InvalidInputError
+        A quaternion that is not unit, NaN, wrong shapes.
+    """
+    from ..attitude.core import UNIT_QUATERNION_TOLERANCE, quaternion_from_gibbs, quaternion_from_scipy
+
+    if attitude0 is not None and gibbs0 is not None:
+        raise TypeError("give at most one of attitude0 and gibbs0 (the initial attitude), not both")
+    if gibbs0 is not None:
+        return np.asarray(quaternion_from_gibbs(as_float_array(gibbs0, "gibbs0", (3,))), dtype=float)
+    if attitude0 is None:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    if isinstance(attitude0, Attitude):
+        return attitude0.as_quaternion()
+    if type(attitude0).__name__ == "Rotation" and hasattr(attitude0, "as_quat"):
+        return quaternion_from_scipy(attitude0)
+    q0 = as_float_array(attitude0, "attitude0", (4,))
+    nrm = np.linalg.norm(q0, axis=-1)
+    if np.any(np.abs(nrm - 1.0) > UNIT_QUATERNION_TOLERANCE):
+        worst = float(nrm.ravel()[np.argmax(np.abs(nrm.ravel() - 1.0))])
+        raise InvalidInputError(
+            f"attitude0 must be a unit quaternion (w, x, y, z), norm 1 within {UNIT_QUATERNION_TOLERANCE:g}; "
+            f"its norm is {worst:.9g}"
+        )
+    return as_quaternion(q0, "attitude0")
+
+
+def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None) -> Problem:
     """Validate and broadcast the arguments of :func:`solve` into a :class:`Problem`.
 
     Raises
@@ -90,18 +129,7 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, torque=None) 
     times = _as_times(t)
     if (omega0 is None) == (m0 is None):
         raise TypeError("give exactly one of omega0 (body angular velocity) or m0 (spatial angular momentum)")
-    if attitude0 is None:
-        q0 = np.array([1.0, 0.0, 0.0, 0.0])
-    elif isinstance(attitude0, Attitude):
-        q0 = attitude0.as_quaternion()
-    else:
-        q0 = as_float_array(attitude0, "attitude0", (4,))
-        nrm = np.linalg.norm(q0, axis=-1)
-        if np.any(np.abs(nrm - 1.0) > 1e-8):
-            raise InvalidInputError(
-                f"attitude0 must be a unit quaternion (w, x, y, z); its norm is {float(nrm.ravel()[np.argmax(np.abs(nrm.ravel() - 1.0))]):.9g}"
-            )
-        q0 = as_quaternion(q0, "attitude0")
+    q0 = initial_quaternion(attitude0, gibbs0)
     name, v0 = ("omega0", omega0) if omega0 is not None else ("m0", m0)
     v0 = as_float_array(v0, name, (3,))
     try:

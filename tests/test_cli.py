@@ -75,7 +75,7 @@ def test_simulate_toml_and_flag_override(capsys, tmp_path):
         (["simulate", "--inertia", "1,1,3", "--omega", "1,0,0", "--t-end", "1"], "triangle inequality"),
         (["simulate", "--inertia", "1,2,3,4,5,6,7,8,9", "--omega", "1,0,0", "--t-end", "1"], "not symmetric"),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--quaternion", "1,1,0,0", "--t-end", "1"], "unit quaternion"),
-        (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "-1"], "t-end must be a finite number >= 0"),
+        (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "inf"], "t-end must be a finite number"),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,nan", "--t-end", "1"], "finite"),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--method", "magic"], "unknown method 'magic'"),
         (["simulate", "--inertia", "1,2,3", "--t-end", "1"], "exactly one initial condition"),
@@ -124,7 +124,7 @@ def test_version_and_help(capsys):
 
 def test_console_script_entry_point(tmp_path):
     exe = os.path.join(os.path.dirname(sys.executable), "eulerpoisson")
-    res = subprocess.run([exe, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "-5"],
+    res = subprocess.run([exe, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "nan"],
                          capture_output=True, text=True, timeout=120)
     assert res.returncode == 2
     assert len(res.stderr.strip().splitlines()) == 1

@@ -222,6 +222,15 @@ def _first_index(mask) -> str:
 # ---------------------------------------------------------------------------
 # quaternions
 # ---------------------------------------------------------------------------
+def finite_result(x, what: str, **inputs) -> np.ndarray:
+    """``x`` when it is finite; an :class:`~eulerpoisson.errors.InvalidInputError` naming ``what`` and its
+    largest input when float64 overflowed (never a silent inf)."""
+    if np.all(np.isfinite(x)):
+        return x
+    desc = ", ".join(f"max |{k}| = {float(np.max(np.abs(v))):.3g}" for k, v in inputs.items())
+    raise InvalidInputError(f"{what} overflows float64 for these inputs ({desc}); rescale them")
+
+
 def as_quaternion(q, name="q") -> np.ndarray:
     """Validate and normalize quaternions (power-of-two prescaling: no overflow/underflow)."""
     q = as_float_array(q, name, (4,))
@@ -261,7 +270,9 @@ def quaternion_multiply(p, q) -> np.ndarray:
     p = as_float_array(p, "p", (4,))
     q = as_float_array(q, "q", (4,))
     check_broadcast(p=p, q=q)
-    return qmul(p, q)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = qmul(p, q)
+    return finite_result(out, "quaternion_multiply", p=p, q=q)
 
 
 def quaternion_conjugate(q) -> np.ndarray:
@@ -1497,7 +1508,9 @@ def inverse_conversion_matrix(n) -> np.ndarray:
     Paper eq. 1.12.
     """
     n = as_float_array(n, "n", (3,))
-    return _At(n)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = _At(n)
+    return finite_result(out, "inverse_conversion_matrix", n=n)
 
 
 def _At(n):
@@ -1649,8 +1662,11 @@ def metric(n, inertia) -> np.ndarray:
     """
     n = as_float_array(n, "n", (3,))
     I = _inertia_arrays(inertia)
-    A = _A(n)
-    return 4.0 * A @ I @ np.swapaxes(A, -1, -2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        A = _A(n)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = 4.0 * A @ I @ np.swapaxes(A, -1, -2)
+    return finite_result(out, "metric", n=n)
 
 
 def inverse_metric(n, inertia) -> np.ndarray:
@@ -1679,8 +1695,11 @@ def inverse_metric(n, inertia) -> np.ndarray:
     """
     n = as_float_array(n, "n", (3,))
     Iinv = _inertia_arrays(inertia, inverse=True)
-    At = _At(n)
-    return 0.25 * np.swapaxes(At, -1, -2) @ Iinv @ At
+    with np.errstate(over="ignore", invalid="ignore"):
+        At = _At(n)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = 0.25 * np.swapaxes(At, -1, -2) @ Iinv @ At
+    return finite_result(out, "inverse_metric", n=n)
 
 
 # ---------------------------------------------------------------------------

@@ -54,6 +54,9 @@ def _floats(text, name: str, sizes: tuple[int, ...]) -> list[float]:
         parts = [p for p in str(text).replace(";", ",").replace(" ", ",").split(",") if p != ""]
         vals = []
         for p in parts:
+            if not p.isascii():
+                raise UsageError(f"{name}: {p!r} is not a number written in ASCII digits (expected "
+                                 f"{' or '.join(map(str, sizes))} comma-separated numbers)")
             try:
                 vals.append(float(p))
             except ValueError:
@@ -95,6 +98,8 @@ def _load_toml(path: str) -> dict:
             return tomllib.load(fh)
     except tomllib.TOMLDecodeError as exc:
         raise UsageError(f"{path}: invalid TOML: {exc}") from None
+    except RecursionError:
+        raise UsageError(f"{path}: invalid TOML: nested too deeply (a configuration has two levels)") from None
     except UnicodeDecodeError as exc:
         raise UsageError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
                          "a TOML file must be UTF-8") from None
@@ -130,7 +135,7 @@ METHOD_OPTIONS = _method_option_kinds()
 
 #: what each TOML key of ``simulate`` holds (checked when the file is read; nothing is coerced)
 _TOML_KINDS = {
-    "body": {"inertia": "inertia", "masses": "numbers", "positions": "points", "name": "str"},
+    "body": {"inertia": "inertia", "masses": "numbers", "positions": "points", "name": "str", "allow_unphysical": "bool"},
     "initial": {"omega": "numbers", "m": "numbers", "quaternion": "numbers", "gibbs": "numbers"},
     "time": {"t_end": "number", "samples": "int"},
     "method": {"name": "str", **METHOD_OPTIONS},
@@ -212,6 +217,9 @@ def _config_from_toml(cfg: dict, path: str, src: dict | None = None) -> dict:
             out[f"{section}.{k}"] = _toml_value(_TOML_KINDS[section][k], v, where)
             if src is not None:
                 src[f"{section}.{k}"] = where
+    # a file name in the file is relative to the file, not to the working directory
+    if isinstance(out.get("output.file"), str) and out["output.file"].strip() and not os.path.isabs(out["output.file"]):
+        out["output.file"] = os.path.join(os.path.dirname(os.path.abspath(path)), out["output.file"])
     return out
 
 
@@ -221,6 +229,7 @@ def _config_from_toml(cfg: dict, path: str, src: dict | None = None) -> dict:
 #: command-line flag of each configuration key (the name used in messages when the value came from a flag)
 _FLAGS = {
     "body.inertia": "--inertia",
+    "body.allow_unphysical": "--allow-unphysical",
     "initial.omega": "--omega",
     "initial.m": "--m",
     "initial.quaternion": "--quaternion",
@@ -300,7 +309,8 @@ def _build_body(cfg, name=None):
         return RigidBody.from_particles(masses, positions, name=label)
     if "body.inertia" not in cfg:
         raise UsageError("no body given: use --inertia I1,I2,I3 (or nine numbers) or a TOML file with [body]")
-    return RigidBody(_inertia_from(cfg["body.inertia"], name("body.inertia")), name=label)
+    return RigidBody(_inertia_from(cfg["body.inertia"], name("body.inertia")), name=label,
+                     allow_unphysical=bool(cfg.get("body.allow_unphysical", False)))
 
 
 def _number(value, name: str, *, positive: bool = False) -> float:
@@ -395,7 +405,7 @@ def _torque_records(model) -> list[dict]:
 
 
 def _state_json(traj, drift) -> dict:
-    i = int(np.argmax(traj.t))
+    i = int(np.argmax(np.abs(traj.t)))  # the state at T (T < 0: backwards)
     q = traj.quaternion[..., i, :]
     sing = bool(q[0] == 0)
     return {
@@ -478,7 +488,7 @@ def cmd_simulate(args) -> int:
     given = {key: getattr(args, attr) for attr, key in (
         ("inertia", "body.inertia"), ("omega", "initial.omega"), ("m", "initial.m"),
         ("quaternion", "initial.quaternion"), ("gibbs", "initial.gibbs"), ("t_end", "time.t_end"),
-        ("samples", "time.samples"), ("method", "method.name"),
+        ("samples", "time.samples"), ("method", "method.name"), ("allow_unphysical", "body.allow_unphysical"),
         *((opt, f"method.{opt}") for opt in METHOD_OPTIONS), ("out", "output.file"),
         ("gravity", "torque.gravity"), ("mass", "torque.mass"), ("com", "torque.center_of_mass"),
         ("gravity_gradient", "torque.gravity_gradient"), ("body_torque", "torque.body_torque"),
@@ -535,8 +545,9 @@ def cmd_simulate(args) -> int:
         t_end = float(cfg["time.t_end"])
     except (TypeError, ValueError):
         raise UsageError(f"{name('time.t_end')}: {cfg['time.t_end']!r} is not a number") from None
-    if not math.isfinite(t_end) or t_end < 0:
-        raise UsageError(f"{name('time.t_end')} must be a finite number >= 0, got {cfg['time.t_end']!r}")
+    if not math.isfinite(t_end):
+        raise UsageError(f"{name('time.t_end')} must be a finite number (negative: backwards in time), "
+                         f"got {cfg['time.t_end']!r}")
     samples = cfg.get("time.samples", 1001)
     if isinstance(samples, str):
         try:
@@ -802,7 +813,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--m", help="initial spatial angular momentum m1,m2,m3 (instead of --omega)")
     s.add_argument("--quaternion", help="initial attitude w,x,y,z (unit, scalar first); default identity")
     s.add_argument("--gibbs", help="initial attitude as the Gibbs vector n1,n2,n3")
-    s.add_argument("--t-end", dest="t_end", help="final time T >= 0")
+    s.add_argument("--t-end", dest="t_end", help="final time T (negative: the motion backwards from t = 0)")
+    s.add_argument("--allow-unphysical", dest="allow_unphysical", action="store_true", default=None,
+                   help="accept moments that violate the triangle inequality (e.g. 3,5,9: no mass distribution has them)")
     s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
     s.add_argument("--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)")
     for opt in METHOD_OPTIONS:  # every option of every method, read from the option dataclasses
@@ -1021,6 +1034,14 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("eulerpoisson: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader closed the pipe (``eulerpoisson info run.nc | head``): not an error
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):  # pragma: no cover - stdout without a file descriptor
+            pass
+        return 0
     except Exception as exc:  # noqa: BLE001 - the command line never shows a traceback without --debug
         if debug:
             raise

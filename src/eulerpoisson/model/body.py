@@ -545,7 +545,11 @@ class RigidBody:
             Wrong shape or non-finite values.
         """
         w = as_float_array(omega, "omega", (3,))
-        return 0.5 * np.sum(w * self.angular_momentum(w), -1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            E = 0.5 * np.sum(w * self.angular_momentum(w), -1)
+        if not np.all(np.isfinite(E)):
+            raise InvalidInputError(f"energy overflows float64 (max |omega| = {float(np.max(np.abs(w))):.3g}); rescale omega")
+        return E
 
     def to_principal(self, v) -> np.ndarray:
         """Components of body-frame vectors in the principal frame: ``P^T v``.

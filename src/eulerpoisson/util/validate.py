@@ -39,11 +39,13 @@ def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite:
     """
     if isinstance(x, (str, bytes)):
         raise TypeError(f"{name} must be numeric, got the string {x!r}")
+    if isinstance(x, np.ma.MaskedArray):
+        raise TypeError(f"{name} is a masked array; its mask would be ignored: fill or drop the masked values first")
     try:
         a = np.asarray(x)
     except Exception as exc:  # ragged lists etc.
         raise InvalidInputError(f"{name} could not be converted to an array: {exc}") from exc
-    if a.dtype == object or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
+    if a.dtype == object or not np.issubdtype(a.dtype, np.number):
         raise TypeError(f"{name} must be a real numeric array, got dtype {a.dtype}")
     if np.iscomplexobj(a):
         raise TypeError(f"{name} must be real, got complex dtype {a.dtype}")

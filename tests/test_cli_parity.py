@@ -1,0 +1,97 @@
+"""The command line says what the API can (issue: files, long runs and the command line made whole)."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import eulerpoisson as ep
+from eulerpoisson.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_allow_unphysical_flag_and_toml_key(capsys, tmp_path):
+    code, out, err = run(capsys, "simulate", "--inertia", "3,5,9", "--omega", "0,0.4,0.001", "--t-end", "1")
+    assert code == 2 and "allow_unphysical" in err or "triangle" in err
+    code, out, err = run(capsys, "simulate", "--inertia", "3,5,9", "--omega", "0,0.4,0.001", "--t-end", "1",
+                         "--allow-unphysical", "--json")
+    assert code == 0 and '"t": 1.0' in out
+    cfg = tmp_path / "r.toml"
+    cfg.write_text('[body]\ninertia = [3, 5, 9]\nallow_unphysical = true\n[initial]\nomega = [0, 0.4, 0.001]\n'
+                   '[time]\nt_end = 1.0\n')
+    code, out, err = run(capsys, "simulate", str(cfg), "--json")
+    assert code == 0, err
+
+
+def test_negative_t_end_runs_backwards(capsys):
+    import json
+
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "-5",
+                         "--samples", "11", "--json")
+    assert code == 0, err
+    state = json.loads(out)
+    ref = ep.solve([1, 2, 3], [-5.0], omega0=[1, 0.1, 0.5])
+    assert state["t"] == -5.0
+    np.testing.assert_allclose(state["quaternion"], ref.quaternion[-1], atol=1e-15)
+
+
+def test_every_method_option_is_a_flag(capsys):
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
+                         "--method", "rk", "--integrator", "RK45", "--rtol", "1e-9", "--atol", "1e-12", "--json")
+    assert code == 0, err
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
+                         "--method", "taylor", "--order", "12", "--max-steps", "100000", "--json")
+    assert code == 0, err
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
+                         "--method", "taylor", "--integrator", "RK45")
+    assert code == 2 and err.strip().endswith("--integrator is not an option of method 'taylor' "
+                                              "(its options: --chart-threshold, --dt, --max-steps, --order, --tol)")
+
+
+def test_toml_output_file_is_relative_to_the_file(capsys, tmp_path, monkeypatch):
+    sub = tmp_path / "cfg"
+    sub.mkdir()
+    (sub / "r.toml").write_text('[body]\ninertia = [1, 2, 3]\n[initial]\nomega = [1, 0.1, 0.5]\n'
+                                '[time]\nt_end = 1.0\nsamples = 3\n[output]\nfile = "out.nc"\n')
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run(capsys, "simulate", "cfg/r.toml", "--quiet")
+    assert code == 0, err
+    assert (sub / "out.nc").exists() and not (tmp_path / "out.nc").exists()
+
+
+def test_numbers_must_be_ascii_and_nesting_is_bounded(capsys, tmp_path):
+    code, out, err = run(capsys, "simulate", "--inertia", "\uff11,2,3", "--omega", "1,0,0", "--t-end", "1")
+    assert code == 2 and "is not a number written in ASCII digits" in err
+    deep = tmp_path / "deep.toml"
+    deep.write_text("x = " + "[" * 5000 + "]" * 5000 + "\n")
+    code, out, err = run(capsys, "simulate", str(deep))
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "deep.toml" in err
+
+
+def test_a_closed_pipe_is_not_an_error(tmp_path):
+    exe = str(Path(sys.executable).with_name("eulerpoisson"))
+    cmd = (f"{exe} simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 10 --samples 200000 --method exact --json "
+           f"| head -c 10")
+    res = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True, timeout=120)
+    assert "Broken pipe" not in res.stderr, res.stderr
+    assert res.returncode == 0, res.stderr
+
+
+def test_overflow_and_masked_or_boolean_input_are_errors():
+    with pytest.raises(ep.InvalidInputError, match="inverse_conversion_matrix overflows float64"):
+        ep.attitude.inverse_conversion_matrix([1e308, 0, 0])
+    with pytest.raises(ep.InvalidInputError, match="quaternion_multiply overflows float64"):
+        ep.attitude.quaternion_multiply([1e308, 0, 0, 0], [1e308, 0, 0, 0])
+    with pytest.raises(ep.InvalidInputError, match="energy overflows float64"):
+        ep.RigidBody([1, 2, 3]).energy([1e308, 0, 0])
+    with pytest.raises(TypeError, match="masked array; its mask would be ignored"):
+        ep.RigidBody(np.ma.masked_array([1.0, 2.0, 3.0], [0, 1, 0]))
+    with pytest.raises(TypeError, match="inertia must be a real numeric array, got dtype bool"):
+        ep.RigidBody(np.array([True, True, True]))

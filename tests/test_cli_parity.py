@@ -95,3 +95,12 @@ def test_overflow_and_masked_or_boolean_input_are_errors():
         ep.RigidBody(np.ma.masked_array([1.0, 2.0, 3.0], [0, 1, 0]))
     with pytest.raises(TypeError, match="inertia must be a real numeric array, got dtype bool"):
         ep.RigidBody(np.array([True, True, True]))
+
+
+def test_absurd_and_too_large_sample_counts_are_named_before_allocating(capsys):
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
+                         "--samples", "99999999999999999999999")
+    assert code == 2 and "--samples = 99999999999999999999999 is more than 1e+13 output times" in err
+    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
+                         "--samples", "1000000000000")
+    assert code == 2 and "GiB in memory" in err and "--out run.zarr" in err

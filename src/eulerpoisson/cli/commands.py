@@ -400,6 +400,27 @@ def _method_options(cfg, name=None, method: str | None = None) -> dict:
     return opts
 
 
+#: most output times of one run (a float64 time axis has 2**53 distinct integers; far beyond any disk)
+MAX_SAMPLES = 10**13
+
+#: bytes per sample and body of an in-memory run: q, omega, their copies in the Trajectory and the derived
+#: quantities written to a file (M, m, energy, Gibbs vector), float64
+_BYTES_PER_SAMPLE = 8 * (4 + 3) * 4 + 8 * (3 + 3 + 1 + 3)
+
+
+def _memory_needed(samples: int, batch_shape) -> float:
+    bodies = int(np.prod(batch_shape)) if batch_shape else 1
+    return float(samples) * bodies * _BYTES_PER_SAMPLE
+
+
+def _memory_available() -> float | None:
+    """Available memory in bytes (None where the system does not say)."""
+    try:
+        return float(os.sysconf("SC_AVPHYS_PAGES")) * float(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        return None
+
+
 def _torque_records(model) -> list[dict]:
     return [tq.to_dict() for tq in model.torques]
 
@@ -556,6 +577,18 @@ def cmd_simulate(args) -> int:
             raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples!r}") from None
     if samples < 2:
         raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples}")
+    if samples > MAX_SAMPLES:
+        raise UsageError(f"{name('time.samples')} = {samples} is more than {MAX_SAMPLES:.3g} output times, which no "
+                         f"file or memory holds (a .zarr store of 1e8 samples is about 11 GB)")
+    out_name = cfg.get("output.file")
+    if not (isinstance(out_name, str) and out_name.endswith(".zarr")):
+        need = _memory_needed(samples, body.batch_shape)
+        free = _memory_available()
+        if free is not None and need > free:
+            raise UsageError(
+                f"{name('time.samples')} = {samples} needs about {need / 2**30:.3g} GiB in memory, more than the "
+                f"{free / 2**30:.3g} GiB available; stream it to disk instead: --out run.zarr"
+            )
     torques = _build_torques(cfg, name)
     model = Model(body, torques)
     # the closed form runs the free body (and the Lagrange top); under a torque the default is taylor

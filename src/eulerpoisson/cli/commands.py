@@ -1014,7 +1014,7 @@ def _message(exc: BaseException) -> str:
 def _error_line(exc: BaseException) -> str:
     msg = _message(exc)
     if isinstance(exc, UsageError):
-        return msg
+        return f"eulerpoisson: error: {msg}"  # every error line starts the same way
     if isinstance(exc, MemoryError):
         msg = f"out of memory: {msg}" if msg != type(exc).__name__ else "out of memory"
     elif isinstance(exc, OverflowError) and "overflow" not in msg.lower():

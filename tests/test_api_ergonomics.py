@@ -78,3 +78,38 @@ def test_trajectory_plot_method(tmp_path):
     tr = ep.solve([1, 2, 3], np.linspace(0, 5, 51), omega0=[1, 0.1, 0.5])
     fig = tr.plot("polhode", out=tmp_path / "p.png")
     assert (tmp_path / "p.png").stat().st_size > 1000 and fig is not None
+
+
+def test_taylor_in_long_double_and_mpmath_rounds_once_to_the_closed_form():
+    w0 = np.array([1.0, 0.1, 0.5])
+    ref = ep.solve([1, 2, 3], [10.0], omega0=w0)
+    for opts in ({"precision": "longdouble", "tol": 2e-19}, {"precision": "mpmath", "dps": 30, "tol": 1e-28}):
+        tr = ep.solve([1, 2, 3], [10.0], omega0=w0, method="taylor", **opts)
+        assert tr.stats["precision"] == opts["precision"]
+        assert np.max(np.abs(tr.quaternion - ref.quaternion)) <= 5e-16
+    with pytest.raises(InvalidInputError, match="precision must be one of float64, longdouble, mpmath"):
+        ep.solve([1, 2, 3], [1.0], omega0=w0, method="taylor", precision="quad")
+    with pytest.raises(InvalidInputError, match="precision='longdouble' is for the free body"):
+        ep.solve([1, 2, 3], [1.0], omega0=w0, method="taylor", precision="longdouble",
+                 torque=GravityGradient(0.1))
+
+
+def test_long_double_input_is_kept_or_its_rounding_said():
+    w0 = np.array([1.0, 0.1, 0.5], dtype=np.longdouble) + np.longdouble(1e-18)
+    with pytest.warns(UserWarning, match="given in long double; method 'exact' computes in float64"):
+        ep.solve([1, 2, 3], [1.0], omega0=w0)
+    tr = ep.solve([1, 2, 3], [0.0, 1.0], omega0=w0, method="taylor", precision="longdouble", tol=2e-19)
+    assert tr.stats["precision"] == "longdouble"
+
+
+def test_precision_from_the_command_line(capsys):
+    from eulerpoisson.cli import main
+
+    code = main(["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "5", "--method", "taylor",
+                 "--precision", "longdouble", "--tol", "2e-19", "--json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    import json
+
+    ref = ep.solve([1, 2, 3], [5.0], omega0=[1, 0.1, 0.5])
+    assert np.max(np.abs(np.array(json.loads(out)["quaternion"]) - ref.quaternion[-1])) <= 5e-16

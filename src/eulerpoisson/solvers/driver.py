@@ -105,6 +105,13 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=
         m = cls(**options)
     problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, gibbs0=gibbs0, torque=torque)
     check_supported(method, problem.model)
+    if problem.extended and m.config.get("precision", "float64") == "float64":
+        import warnings
+
+        warnings.warn(
+            f"the initial state is given in long double; method {method!r} computes in float64 and rounds it "
+            f"(method='taylor' with precision='longdouble' keeps it)", stacklevel=2,
+        )
     if not cls.negative_times and np.any(problem.t < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
     start = _time.perf_counter()

@@ -6,7 +6,7 @@ r"""The initial value problem every solution method receives: :class:`Problem`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -35,12 +35,17 @@ class Problem:
         Initial body angular velocities, in the body frame of ``body.inertia``.
     t : ndarray, shape (T,)
         Output times, any order, negative allowed.
+    extended : dict
+        ``"omega0"``, ``"q0"``: the initial state as given in long double,
+        broadcast like ``omega0``/``q0`` (only when it was given so), for
+        methods that compute in extended precision.
     """
 
     model: Model
     q0: np.ndarray
     omega0: np.ndarray
     t: np.ndarray
+    extended: dict = field(default_factory=dict)
 
     @property
     def body(self) -> RigidBody:
@@ -149,7 +154,14 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, 
         w0 = np.einsum("...ij,...j->...i", body.inertia_inv, M)
     q0 = np.broadcast_to(q0, shape + (4,)).copy()
     w0 = np.broadcast_to(w0, shape + (3,)).copy()
-    return Problem(model=model, q0=q0, omega0=w0, t=times)
+    extended = {}
+    if omega0 is not None and getattr(omega0, "dtype", None) == np.longdouble:
+        extended["omega0"] = np.broadcast_to(omega0, shape + (3,)).copy()
+    if getattr(attitude0, "dtype", None) == np.longdouble:
+        qe = np.asarray(attitude0)
+        qe = qe / np.sqrt(np.sum(qe * qe, axis=-1, keepdims=True))
+        extended["q0"] = np.broadcast_to(qe, shape + (4,)).copy()
+    return Problem(model=model, q0=q0, omega0=w0, t=times, extended=extended)
 
 
 def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:

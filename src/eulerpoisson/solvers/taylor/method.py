@@ -88,6 +88,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 import numbers
+from contextlib import nullcontext as _nullcontext
 
 import numpy as np
 
@@ -95,7 +96,7 @@ from ...util.validate import as_float_array, as_scalar
 from ...attitude.core import quaternion_from_rotation_matrix
 from ...model.free_body import euler_coefficients
 from ...numerics.quaternion import qmul
-from ...errors import EulerPoissonError, InvalidInputError
+from ...errors import EulerPoissonError, InvalidInputError, require
 from ..problem import Problem
 from ..registry import Method, MethodOptions, MethodResult, register_method
 from . import kernels as _k
@@ -461,6 +462,10 @@ def integrate_principal(
     return q, om, stats
 
 
+#: arithmetic of the free-body Taylor integration (``precision=``)
+PRECISIONS = ("float64", "longdouble", "mpmath")
+
+
 @dataclass(frozen=True)
 class TaylorOptions(MethodOptions):
     """Options of ``method="taylor"``; see :class:`Taylor` for their meaning."""
@@ -472,14 +477,20 @@ class TaylorOptions(MethodOptions):
     dt: float | None = None
     max_steps: int = 1_000_000
     chart_threshold: float = 1.0
+    precision: str = "float64"
+    dps: int = 30
 
     def check(self) -> None:
         c = cfg = self.to_dict()
+        if c["precision"] not in PRECISIONS:
+            raise InvalidInputError(f"precision must be one of {', '.join(PRECISIONS)}, got {c['precision']!r}")
+        if isinstance(c["dps"], bool) or not isinstance(c["dps"], (int, np.integer)) or not 16 <= c["dps"] <= 1000:
+            raise InvalidInputError(f"dps (mpmath decimal digits) must be an integer in [16, 1000], got {c['dps']!r}")
         if c["dt"] is not None:
             as_scalar(c["dt"], "dt", positive=True)
         if c["order"] is not None:
             _check_order(c["order"], adaptive=c["dt"] is None)
-        _check_tol(c["tol"], np.float64)
+        _check_tol(c["tol"], {"float64": np.float64, "longdouble": np.longdouble, "mpmath": object}[c["precision"]])
         as_scalar(c["max_steps"], "max_steps", positive=True, integer=True)
         as_scalar(c["chart_threshold"], "chart_threshold", nonnegative=True)
         self._update(cfg)
@@ -574,9 +585,11 @@ class Taylor(Method):
         B = int(np.prod(bshape)) if bshape else 1
         moments = np.ascontiguousarray(problem.principal_moments).reshape(B, 3)
         P = np.ascontiguousarray(problem.principal_axes).reshape(B, 3, 3)
-        w0 = problem.omega0.reshape(B, 3)
-        q0 = problem.q0.reshape(B, 4)
+        w0 = problem.extended.get("omega0", problem.omega0).reshape(B, 3)
+        q0 = problem.extended.get("q0", problem.q0).reshape(B, 4)
         diagonal = problem.body.is_diagonal
+        if c["precision"] != "float64":
+            return self._run_extended(problem, moments, P, w0, q0, diagonal)
         if diagonal:
             w0p, qref0 = w0, q0
         else:
@@ -594,11 +607,52 @@ class Taylor(Method):
         T = problem.t.shape[0]
         return MethodResult(q=q.reshape(bshape + (T, 4)), omega=om.reshape(bshape + (T, 3)), stats=stats)
 
+    def _run_extended(self, problem, moments, P, w0, q0, diagonal) -> MethodResult:
+        """The free body in long double or mpmath (``precision=``): the NumPy kernels in that arithmetic,
+        rounded to float64 once, at the end."""
+        c = self.config
+        if c["precision"] == "longdouble":
+            conv = lambda a: np.asarray(a, dtype=np.longdouble)  # noqa: E731
+            ctx = _nullcontext()
+        else:
+            mpmath = require("mpmath", "symbolic")
+            ctx = mpmath.workdps(int(c["dps"]))
+
+            def conv(a):
+                a = np.asarray(a)
+                out = np.empty(a.shape, dtype=object)
+                for i, v in np.ndenumerate(a):
+                    out[i] = mpmath.mpf(v) if not isinstance(v, mpmath.mpf) else v
+                return out
+        with ctx:
+            m, w, q, Pg = conv(moments), conv(w0), conv(q0), conv(P)
+            if not diagonal:
+                w = np.einsum("bji,bj->bi", Pg, w)
+                q = qmul(q, conv(quaternion_from_rotation_matrix(P)))
+            qo, om, stats = integrate_principal(m, w, conv(problem.t), q0=q, tol=c["tol"], order=c["order"],
+                                                dt=c["dt"], max_steps=c["max_steps"],
+                                                chart_threshold=c["chart_threshold"], backend="numpy")
+            if qo.ndim == 2:
+                qo, om = qo[None], om[None]
+            if not diagonal:
+                qPc = conv(quaternion_from_rotation_matrix(P) * np.array([1.0, -1.0, -1.0, -1.0]))
+                qo = qmul(qo, qPc[:, None, :])
+                om = np.einsum("bij,btj->bti", Pg, om)
+            qf = np.asarray(qo.astype(float) if qo.dtype != object else np.vectorize(float)(qo), dtype=float)
+            wf = np.asarray(om.astype(float) if om.dtype != object else np.vectorize(float)(om), dtype=float)
+        stats = {**stats, "precision": c["precision"]}
+        bshape = problem.batch_shape
+        T = problem.t.shape[0]
+        return MethodResult(q=qf.reshape(bshape + (T, 4)), omega=wf.reshape(bshape + (T, 3)), stats=stats)
+
     def _run_torque(self, problem: Problem) -> MethodResult:
         """Bodies under polynomial torques: (q, Omega) with Poisson vectors (:mod:`.torque`)."""
         from .torque import integrate_polynomial, polynomial_data
 
         c = self.config
+        if c["precision"] != "float64":
+            raise InvalidInputError(f"taylor: precision={c['precision']!r} is for the free body; under torque "
+                                    f"the integration runs in float64 (precision='float64')")
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
         data = polynomial_data(problem.model.polynomial(), bshape)

@@ -52,7 +52,7 @@ def test_every_method_option_is_a_flag(capsys):
     code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
                          "--method", "taylor", "--integrator", "RK45")
     assert code == 2 and err.strip().endswith("--integrator is not an option of method 'taylor' "
-                                              "(its options: --chart-threshold, --dt, --max-steps, --order, --tol)")
+                                              "(its options: --chart-threshold, --dps, --dt, --max-steps, --order, --precision, --tol)")
 
 
 def test_toml_output_file_is_relative_to_the_file(capsys, tmp_path, monkeypatch):
@@ -104,3 +104,14 @@ def test_absurd_and_too_large_sample_counts_are_named_before_allocating(capsys):
     code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
                          "--samples", "1000000000000")
     assert code == 2 and "GiB in memory" in err and "--out run.zarr" in err
+
+
+def test_a_file_with_non_unit_quaternions_is_refused(tmp_path):
+    xr = pytest.importorskip("xarray")
+    tr = ep.solve([1, 2, 3], [0.0, 1.0], omega0=[1, 0.1, 0.5])
+    tr.to_netcdf(tmp_path / "a.nc")
+    ds = xr.open_dataset(tmp_path / "a.nc", engine="h5netcdf").load()
+    ds["quaternion"] = ds["quaternion"] * 2.0
+    ds.to_netcdf(tmp_path / "b.nc", engine="h5netcdf")
+    with pytest.raises(ep.InvalidInputError, match="b.nc: the quaternion variable is not made of unit quaternions"):
+        ep.Trajectory.from_netcdf(tmp_path / "b.nc")

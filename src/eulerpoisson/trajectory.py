@@ -490,6 +490,17 @@ class Trajectory:
                     f"{path}: variable {nm} has shape {a.shape}, expected {lead + tail} "
                     f"(batch_shape {list(bshape)}, {t.shape[0]} times)"
                 )
+        from .attitude.core import UNIT_QUATERNION_TOLERANCE
+
+        with np.errstate(invalid="ignore", over="ignore"):
+            norms = np.sqrt(np.sum(np.asarray(q, dtype=float) ** 2, axis=-1))
+        norms = norms[np.isfinite(norms)]  # NaN and inf are named by the checks below
+        if norms.size and not np.all(np.abs(norms - 1.0) <= UNIT_QUATERNION_TOLERANCE):
+            worst = float(norms[np.argmax(np.abs(norms - 1.0))])
+            raise InvalidInputError(
+                f"{path}: the quaternion variable is not made of unit quaternions (a norm of {worst:.9g}; "
+                f"we write norm 1 within {UNIT_QUATERNION_TOLERANCE:g}): the file was modified or is not ours"
+            )
         if bshape:
             q = q.reshape(bshape + q.shape[1:])
             w = w.reshape(bshape + w.shape[1:])

@@ -303,9 +303,18 @@ class SweepConfig:
 
 
 def _check_scheduler(s, where: str) -> str:
+    import re
+
     if not isinstance(s, str) or not (s in ("local", "serial") or s.startswith(("tcp://", "tls://"))):
         raise InvalidInputError(f"{where} must be 'local', 'serial' or a scheduler address 'tcp://HOST:PORT', got {s!r}")
+    if s.startswith(("tcp://", "tls://")) and not re.fullmatch(r"(tcp|tls)://(\[[0-9a-fA-F:.]+\]|[^:/\s]+):\d{1,5}", s):
+        raise InvalidInputError(f"{where} {s!r} must name a host and a port: 'tcp://HOST:PORT' (e.g. tcp://127.0.0.1:8786)")
     return s
+
+
+def is_remote(scheduler: str) -> bool:
+    """Whether ``scheduler`` is the address of a cluster (tcp:// or tls://), not one started here."""
+    return scheduler.startswith(("tcp://", "tls://"))
 
 
 def load_config(source) -> SweepConfig:
@@ -681,8 +690,9 @@ def _create_store(zarr, store: Path, cfg: SweepConfig) -> None:
 def _local_cluster(workers):
     distributed = require("distributed", "dask")
     n = workers or os.cpu_count() or 1
+    # everything on the loopback interface: no scheduler or dashboard port open to the network
     return distributed.LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+        n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0",
         silence_logs=logging.ERROR,
     )
 
@@ -762,6 +772,11 @@ def run_sweep(
     """
     zarr = require("zarr", "dask")
     cfg = config if isinstance(config, SweepConfig) else load_config(config)
+    if scheduler is None and client is None and is_remote(cfg.scheduler):
+        raise InvalidInputError(
+            f"the sweep file names the scheduler {cfg.scheduler!r}; a file never connects to a cluster on its own: "
+            f"give it explicitly (run_sweep(..., scheduler={cfg.scheduler!r}) or --scheduler {cfg.scheduler})"
+        )
     scheduler = _check_scheduler(scheduler if scheduler is not None else cfg.scheduler, "scheduler")
     if workers is not None:
         workers = _integer(workers, "workers", 1)

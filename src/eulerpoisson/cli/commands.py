@@ -15,6 +15,7 @@ import json
 import math
 import os
 import sys
+import time
 import warnings
 from pathlib import Path
 
@@ -22,6 +23,7 @@ import numpy as np
 
 from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import EulerPoissonError, MissingDependencyError
+from ..errors import require as require_module
 
 __all__ = ["main"]
 
@@ -425,6 +427,25 @@ def _torque_records(model) -> list[dict]:
     return [tq.to_dict() for tq in model.torques]
 
 
+def _first_and_last(path, model):
+    """The first and the last sample of a streamed trajectory store, as a Trajectory (reads two samples)."""
+    from ..trajectory import Trajectory
+
+    xr = require_module("xarray", "io")
+    with xr.open_zarr(str(path), consolidated=None) as ds:
+        idx = [0, ds.sizes["time"] - 1]
+        t = ds["time"].values[idx]
+        q = ds["quaternion"].isel(time=idx).values
+        w = ds["omega"].isel(time=idx).values
+        method = str(ds.attrs.get("method", ""))
+        options = json.loads(ds.attrs.get("method_options", "{}"))
+        bshape = tuple(json.loads(ds.attrs.get("batch_shape", "[]")))
+    if bshape:
+        q = q.reshape(bshape + q.shape[-2:])
+        w = w.reshape(bshape + w.shape[-2:])
+    return Trajectory(t, q, w, model.body, method, options, {}, torque=list(model.torques))
+
+
 def _state_json(traj, drift) -> dict:
     i = int(np.argmax(np.abs(traj.t)))  # the state at T (T < 0: backwards)
     q = traj.quaternion[..., i, :]
@@ -603,19 +624,40 @@ def cmd_simulate(args) -> int:
     progress = False if (args.quiet or as_json) else None
     if out is not None and not str(out).endswith((".nc", ".nc4", ".netcdf", ".zarr")):
         raise UsageError(f"{name('output.file')} {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")
-    if out is not None and str(out).endswith(".zarr"):
-        # long runs stream to disk chunk by chunk (atomic, resumable); the final state is read back
-        from ..io.stream import solve_to_file
+    if out is not None:
+        # one policy for outputs: nothing replaced without --overwrite, never an input or another kind of file
+        from ..io.outputs import OutputLock, check_output
 
-        with _naming_target(out):
-            solve_to_file(model, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
-                          progress=progress, overwrite=True, **opts)
-        traj = solve(model, np.array([0.0, t_end]), omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        zarr_out = str(out).endswith(".zarr")
+        check_output(out, "trajectory-store" if zarr_out else "netcdf", overwrite=bool(args.overwrite),
+                     inputs=[args.config])
+    if out is not None and str(out).endswith(".zarr"):
+        # long runs stream to disk chunk by chunk (atomic, resumable); the state at T is read back from the file
+        from ..io.stream import partial_store, solve_to_file
+
+        if partial_store(out).exists() and not args.overwrite and not args.quiet and not as_json:
+            print(f"resuming the interrupted run to {out} from its finished chunks (--overwrite starts afresh)",
+                  file=sys.stderr)
+        start = time.perf_counter()
+        with OutputLock(out), _naming_target(out):
+            try:
+                solve_to_file(model, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
+                              progress=progress, resume=not args.overwrite, overwrite=bool(args.overwrite), **opts)
+            except KeyboardInterrupt:
+                print(f"eulerpoisson: interrupted; the finished chunks of {out} are kept: run the same command "
+                      f"again to resume", file=sys.stderr)
+                raise
+            except EulerPoissonError as exc:
+                raise type(exc)(str(exc).replace("pass overwrite=True", "run again with --overwrite")
+                                .replace("overwrite=True", "--overwrite")) from exc
+        traj = _first_and_last(out, model)
+        traj.stats["wall_time"] = time.perf_counter() - start
     else:
         t = np.linspace(0.0, t_end, samples)
         traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
         if out is not None:
-            traj.to_netcdf(out)
+            with OutputLock(out):
+                traj.to_netcdf(out)
     drift = traj.drift()
     if as_json:
         print(json.dumps(_state_json(traj, drift)))
@@ -640,9 +682,16 @@ def cmd_audit(args) -> int:
     from ..paper.audit import run_audit, write_report
 
     _check_file_name(args.out, "--out")
+    if args.out is not None:
+        from ..io.outputs import check_output
+
+        check_output(args.out, "file", overwrite=bool(args.overwrite))  # before the 25 s of the audit
     report = run_audit()
     if args.out is not None:
-        write_report(report, args.format, args.out)
+        from ..io.outputs import OutputLock
+
+        with OutputLock(args.out):
+            write_report(report, args.format, args.out)
         if not args.quiet:
             print(f"wrote {args.out}")
     else:
@@ -768,8 +817,12 @@ def cmd_sweep(args) -> int:
     except UnicodeDecodeError as exc:
         raise UsageError(f"{args.config}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
                          "a TOML file must be UTF-8") from None
+    from ..io.outputs import OutputLock, check_output
+
+    target = args.out if args.out is not None else cfg.path
+    check_output(target, "sweep-store", overwrite=bool(args.overwrite), inputs=[args.config])
     try:
-        with _naming_target(args.out if args.out is not None else cfg.path):
+        with OutputLock(target), _naming_target(target):
             path = run_sweep(
                 cfg,
                 path=args.out,
@@ -868,6 +921,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--out", help="write the trajectory to this NetCDF (.nc) file or stream it to a Zarr (.zarr) store")
     s.add_argument("--json", action="store_true",
                    help="print the state at T, the torques, the integrals at T and their drift as one JSON object")
+    s.add_argument("--overwrite", action="store_true",
+                   help="replace an existing output of the same kind (an interrupted .zarr run resumes without it)")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=cmd_simulate)
 
@@ -879,6 +934,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     a.add_argument("--format", choices=["md", "json", "tex"], default="md", help="report format (default md)")
     a.add_argument("--out", help="write the report to this file instead of printing it")
+    a.add_argument("--overwrite", action="store_true", help="replace an existing report file (never a file of another kind)")
     a.add_argument("--quiet", action="store_true")
     a.set_defaults(func=cmd_audit)
 
@@ -939,6 +995,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--out", default="out", help="output folder (default out/)")
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(func=cmd_demo)
+
     return p
 
 

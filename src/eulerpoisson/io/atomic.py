@@ -13,6 +13,8 @@ original error, e.g. :class:`FileNotFoundError`) with the message
 from __future__ import annotations
 
 import contextlib
+import glob
+import stat
 import errno as _errno
 import os
 import tempfile
@@ -34,7 +36,7 @@ def _target(path) -> Path:
     return dest
 
 
-def _write_error(dest, exc: OSError) -> OSError:
+def write_error(dest, exc: OSError) -> OSError:
     """``exc`` re-worded to name ``dest`` (the caller's file), keeping its errno and class."""
     reason = exc.strerror or str(exc) or type(exc).__name__
     if exc.errno is None:
@@ -67,11 +69,12 @@ def atomic_path(path, suffix: str | None = None):
     """
     dest = _target(path)
     parent = dest.parent if str(dest.parent) else Path(".")
+    _remove_stale_temporaries(dest, parent, suffix or ".tmp")
     try:
         parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix or ".tmp", dir=parent)
     except OSError as exc:
-        raise _write_error(dest, exc) from exc
+        raise write_error(dest, exc) from exc
     os.close(fd)
     umask = os.umask(0)
     os.umask(umask)
@@ -81,16 +84,40 @@ def atomic_path(path, suffix: str | None = None):
             yield tmp
         except OSError as exc:
             if _names_tmp(exc, tmp):
-                raise _write_error(dest, exc) from exc
+                raise write_error(dest, exc) from exc
             raise
         try:
+            if dest.is_file():  # a replaced file keeps its permissions
+                os.chmod(tmp, stat.S_IMODE(os.stat(dest).st_mode))
             os.replace(tmp, dest)
         except OSError as exc:
-            raise _write_error(dest, exc) from exc
+            raise write_error(dest, exc) from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def _remove_stale_temporaries(dest: Path, parent: Path, suffix: str) -> None:
+    """Remove the temporary files a killed writer left next to ``dest`` (not while another process holds its lock)."""
+    lock = parent / f".{dest.name}.lock"
+    if lock.exists():
+        try:
+            pid = int(lock.read_text().strip() or "0")
+        except (OSError, ValueError):
+            pid = 0
+        if pid and pid != os.getpid():
+            try:
+                os.kill(pid, 0)
+                return  # a live writer: its temporary file is not stale
+            except ProcessLookupError:
+                pass
+            except PermissionError:
+                return
+    for old in parent.glob(f".{glob.escape(dest.name)}.*{glob.escape(suffix)}"):
+        with contextlib.suppress(OSError):
+            if old.is_file():
+                old.unlink()
 
 
 def atomic_write_text(path, text: str, encoding: str = "utf-8") -> None:

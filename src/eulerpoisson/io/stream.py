@@ -303,6 +303,18 @@ def _work_dir(path: Path) -> Path:
     return path.with_name(f".{path.name}.partial")
 
 
+def _finished_run(path: Path):
+    """The arguments recorded in a finished store (None if there are none or it is not a store of ours)."""
+    try:
+        zarr = require("zarr", "dask")
+        with _quiet_zarr():
+            g = zarr.open_group(str(path), mode="r")
+            raw = g.attrs.get("eulerpoisson_run")
+        return json.loads(raw) if isinstance(raw, str) else None
+    except Exception:  # noqa: BLE001 - anything unreadable is "not a finished run of ours"
+        return None
+
+
 def partial_store(path) -> Path:
     """The Zarr store where :func:`solve_to_file` keeps the chunks of an unfinished run to ``path``.
 
@@ -677,6 +689,8 @@ def solve_to_file(
     if overwrite:
         _check_replaceable(path)  # before any work, not after
     if path.exists() and not overwrite:
+        if resume and _finished_run(path) == fingerprint:
+            return path  # the same run finished before: nothing to do
         raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
     work = _work_dir(path)
     store = work / "store.zarr"
@@ -826,6 +840,8 @@ def solve_to_file(
             "stats": json.dumps(totals, default=float, sort_keys=True),
             "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} streamed by "
             f"eulerpoisson {template.attrs['eulerpoisson_version']} in {nchunks} chunks of {chunk}",
+            # the arguments of the run: a later resume=True with the same ones finds it complete
+            "eulerpoisson_run": json.dumps(fingerprint, sort_keys=True, default=float),
         })
         zarr.consolidate_metadata(str(store))
     _replace_dir(store, path, overwrite)

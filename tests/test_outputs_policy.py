@@ -1,0 +1,134 @@
+"""One policy for every output (issue: files, long runs and the command line made whole, items 1-4, 6).
+
+The concurrency and interruption tests run real processes.
+"""
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import eulerpoisson as ep
+from eulerpoisson.cli import main
+
+pytest.importorskip("zarr")
+xr = pytest.importorskip("xarray")
+
+EXE = str(Path(sys.executable).with_name("eulerpoisson"))
+SIM = ["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10"]
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_existing_outputs_are_replaced_only_with_overwrite_and_keep_their_mode(capsys, tmp_path):
+    out = tmp_path / "run.nc"
+    assert run(capsys, *SIM, "--out", str(out), "--quiet")[0] == 0
+    code, _, err = run(capsys, *SIM, "--out", str(out))
+    assert code == 2 and f"{out} exists; run again with --overwrite to replace it" in err
+    os.chmod(out, 0o444)
+    code, _, err = run(capsys, *SIM, "--samples", "7", "--out", str(out), "--overwrite", "--quiet")
+    assert code == 0, err
+    assert stat.S_IMODE(os.stat(out).st_mode) == 0o444
+    assert len(ep.Trajectory.from_netcdf(out).t) == 7
+
+
+def test_never_an_input_nor_a_file_of_another_kind(capsys, tmp_path):
+    notes = tmp_path / "notes.zarr"
+    notes.write_text("my notes")
+    code, _, err = run(capsys, *SIM, "--out", str(notes), "--overwrite")
+    assert code == 2 and "it is a file that is not NetCDF" in err and notes.read_text() == "my notes"
+    nc = tmp_path / "run.nc"
+    ep.solve([1, 2, 3], [0.0, 1.0], omega0=[1, 0, 0]).to_netcdf(nc)
+    code, _, err = run(capsys, "audit", "--out", str(nc), "--overwrite")
+    assert code == 2 and "it is a NetCDF file" in err
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text((Path(__file__).resolve().parents[1] / "examples" / "sweep.toml").read_text())
+    code, _, err = run(capsys, "sweep", str(cfg), "--out", str(cfg), "--overwrite")
+    assert code == 2 and "it is an input of this command" in err and "[sweep]" in cfg.read_text()
+    store = tmp_path / "t.zarr"
+    assert run(capsys, *SIM, "--samples", "50", "--out", str(store), "--quiet")[0] == 0
+    code, _, err = run(capsys, "sweep", str(cfg), "--out", str(store), "--overwrite")
+    assert code == 2 and "it is a trajectory store" in err and (store / "zarr.json").exists()
+
+
+def test_json_of_a_streamed_run_is_the_last_sample_of_the_file(capsys, tmp_path):
+    store = tmp_path / "r.zarr"
+    code, out, err = run(capsys, *SIM, "--samples", "20000", "--method", "rk", "--out", str(store), "--json")
+    assert code == 0, err
+    state = json.loads(out)
+    with xr.open_zarr(store) as ds:
+        last = ds["quaternion"].values[-1]
+    np.testing.assert_array_equal(state["quaternion"], last)
+
+
+def test_a_second_writer_to_the_same_store_fails_and_the_first_finishes(tmp_path):
+    store = tmp_path / "c.zarr"
+    argv = [EXE, *SIM, "--t-end", "1000", "--samples", "3000000", "--out", str(store), "--quiet"]
+    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    lock = tmp_path / ".c.zarr.lock"
+    for _ in range(600):
+        if lock.exists() or first.poll() is not None:
+            break
+        time.sleep(0.05)
+    assert lock.exists(), "the first writer did not take the lock"
+    second = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    assert second.returncode == 2
+    assert "is being written by another process" in second.stderr and len(second.stderr.strip().splitlines()) == 1
+    out, err = first.communicate(timeout=600)
+    assert first.returncode == 0, err
+    with xr.open_zarr(store) as ds:
+        assert ds.sizes["time"] == 3_000_000
+        assert np.isfinite(ds["quaternion"].values[-1]).all()
+    assert not lock.exists()
+
+
+def test_an_interrupted_stream_resumes_where_it_stopped(tmp_path):
+    store = tmp_path / "r.zarr"
+    argv = [EXE, *SIM, "--t-end", "2000", "--samples", "4000000", "--method", "taylor", "--out", str(store)]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    done = tmp_path / ".r.zarr.partial" / "done"
+    for _ in range(1200):
+        if (done.exists() and len(list(done.iterdir())) >= 2) or proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    if proc.poll() is not None:
+        pytest.skip("the run finished before it could be interrupted (a very fast machine)")
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode != 0 and "run the same command again to resume" in err
+    res = subprocess.run(argv + ["--json"], capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    ref = ep.solve([1, 2, 3], [2000.0], omega0=[1, 0.1, 0.5], method="taylor")
+    state = json.loads(res.stdout)
+    assert np.max(np.abs(np.array(state["quaternion"]) - ref.quaternion[-1])) < 1e-12
+
+
+def test_stale_temporaries_of_a_killed_writer_are_cleaned_up(capsys, tmp_path):
+    out = tmp_path / "x.nc"
+    stale = tmp_path / ".x.nc.abcd1234.tmp"
+    stale.write_text("half a file")
+    assert run(capsys, *SIM, "--out", str(out), "--quiet")[0] == 0
+    assert out.exists() and not stale.exists()
+
+
+def test_resume_after_a_finished_run_finds_it_complete(tmp_path):
+    from eulerpoisson.io.stream import solve_to_file
+
+    p = tmp_path / "a.zarr"
+    solve_to_file([1, 2, 3], (0.0, 10.0, 1000), p, omega0=[1, 0.1, 0.5], progress=False)
+    mtime = (p / "zarr.json").stat().st_mtime_ns
+    assert solve_to_file([1, 2, 3], (0.0, 10.0, 1000), p, omega0=[1, 0.1, 0.5], progress=False, resume=True) == p
+    assert (p / "zarr.json").stat().st_mtime_ns == mtime
+    with pytest.raises(FileExistsError, match="exists; pass overwrite=True"):
+        solve_to_file([1, 2, 3], (0.0, 10.0, 1001), p, omega0=[1, 0.1, 0.5], progress=False, resume=True)

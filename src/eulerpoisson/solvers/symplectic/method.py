@@ -523,7 +523,9 @@ class Symplectic(Method):
         eq. 1.15, with chart changes at :math:`|\mathbf n| = 1`: symplectic
         within each chart, but every chart is left outward, so the energy
         error of the modified Hamiltonian accumulates linearly, O(h^p) per
-        chart change; kept as the paper's variables, not for long runs).
+        chart change; kept as the paper's variables, not for long runs: it
+        runs in NumPy, not in the compiled kernels, and is measured about
+        500 times slower than the default at t = 1e4).
     dt : float or None
         Largest time step (> 0). ``None``: :math:`0.05/\max|\boldsymbol\Omega_0|`
         over the batch (a rotation of 0.05 rad per step).

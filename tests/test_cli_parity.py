@@ -115,3 +115,15 @@ def test_a_file_with_non_unit_quaternions_is_refused(tmp_path):
     ds.to_netcdf(tmp_path / "b.nc", engine="h5netcdf")
     with pytest.raises(ep.InvalidInputError, match="b.nc: the quaternion variable is not made of unit quaternions"):
         ep.Trajectory.from_netcdf(tmp_path / "b.nc")
+
+
+def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
+    from eulerpoisson.cli import commands
+
+    monkeypatch.setattr(commands, "LONG_RUN_STEPS", 100)
+    t = np.linspace(0.0, 1e4, 5)
+    model = ep.Model([1, 2, 3])
+    tr = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
+    assert tr.stats["chunks"] == 5
+    ref = ep.solve([1, 2, 3], t, omega0=[1, 0.1, 0.5])
+    assert np.max(np.abs(tr.quaternion - ref.quaternion)) < 1e-8

@@ -466,6 +466,9 @@ def _state_json(traj, drift) -> dict:
 
 #: output samples above which ``simulate`` works in chunks (and shows a progress bar on a terminal)
 CHUNKED_SAMPLES = 5000
+
+#: a stepping method expected to take more steps than this runs in chunks with a progress bar, whatever the samples
+LONG_RUN_STEPS = 100_000
 CHUNKS = 50
 
 
@@ -482,10 +485,15 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
     from ..io.stream import ProgressDisplay, solve_from
     from ..trajectory import Trajectory
 
-    if t.size < CHUNKED_SAMPLES:
-        return solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
     closed_form = get_method(method).order is None
-    pieces = np.array_split(np.arange(t.size), CHUNKS)
+    long_run = False
+    if not closed_form and omega0 is not None and t.size > 2:
+        # a stepping method turns the body by a few radians per step at most: a long run shows progress too
+        rate = float(np.max(np.linalg.norm(np.atleast_2d(omega0), axis=-1)))
+        long_run = rate * float(np.max(np.abs(t))) / (8 * np.pi) > LONG_RUN_STEPS
+    if t.size < CHUNKED_SAMPLES and not long_run:
+        return solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    pieces = [p for p in np.array_split(np.arange(t.size), min(CHUNKS, t.size)) if p.size]
     qs, ws, wall = [], [], 0.0
     first = None
     with ProgressDisplay(progress, t.size, f"{method}: solving") as bar:

@@ -305,10 +305,21 @@ class RK(Method):
         return q, y[4:]
 
     def _solve_gibbs(self, q0, w0, moments, times, stats):
-        rtol, atol = self._tolerances(w0, 3)
+        f = _rhs_gibbs(moments)  # left invariance: the free body's field does not depend on the chart centre
+        return self._charts(lambda qc: f, q0, w0, times, self._tolerances(w0, 3), stats)
+
+    def _charts(self, make_rhs, q0, w0, times, tolerances, stats):
+        r"""Integrate :math:`(\mathbf n, \boldsymbol\Omega)` in charts :math:`R = R_cR(\mathbf n)` (one time direction).
+
+        ``make_rhs(qc)`` gives the right-hand side in the chart centred at the
+        unit quaternion ``qc`` (4, 1); a terminal event at
+        :math:`|\mathbf n|` = ``chart_threshold`` folds :math:`R(\mathbf n)` into
+        the centre and restarts at :math:`\mathbf n = 0` with the same
+        :math:`\boldsymbol\Omega`. Returns ``q`` (4, T) and ``omega`` (3, T).
+        """
+        rtol, atol = tolerances
         thr = self.config["chart_threshold"]
         thr2 = thr * thr  # float: inf for a huge threshold (no chart change), no OverflowError
-        f = _rhs_gibbs(moments)
 
         def event(t, y):
             return y[0] * y[0] + y[1] * y[1] + y[2] * y[2] - thr2
@@ -320,7 +331,7 @@ class RK(Method):
         ts = times[order]
         qo = np.empty((4, times.size))
         wo = np.empty((3, times.size))
-        qc = q0[:, None].copy()
+        qc = np.asarray(q0, dtype=float).reshape(4, 1).copy()
         y = np.r_[np.zeros(3), w0]
         tcur = 0.0
         tend = float(ts[-1])
@@ -331,7 +342,7 @@ class RK(Method):
                 ys = np.repeat(y[:, None], nrem, axis=1)
                 stop = tend
             else:
-                sol = self._call(f, tcur, tend, y, rtol, atol, stats, events=event)
+                sol = self._call(make_rhs(qc), tcur, tend, y, rtol, atol, stats, events=event)
                 stop = float(sol.t[-1])
                 nrem = int(np.sum(np.abs(ts[k:]) <= abs(stop)))
                 ys = sol.sol(ts[k:k + nrem]) if nrem else np.empty((6, 0))
@@ -411,9 +422,6 @@ class RK(Method):
 
     def _solve_gibbs_model(self, model, q0, w0, times, stats):
         r"""(n, Omega) in charts R = R_c R(n); the torque sees the full attitude R_c R(n)."""
-        rtol, atol = self._tolerances(w0 if np.any(w0) else self._rate_scale(model, q0), 3)
-        thr = self.config["chart_threshold"]
-        thr2 = thr * thr
 
         def make_rhs(qc):
             def f(t, y):
@@ -421,48 +429,10 @@ class RK(Method):
                 o = y[3:]
                 no = n @ o
                 ndot = 0.5 * (o + np.cross(n, o) + no * n)
-                qn = ch.quaternion_from_gibbs(n[:, None])[:, 0]
-                q = ch.qmul(qc[:, None], qn[:, None])[:, 0]
+                q = ch.qmul(qc, ch.quaternion_from_gibbs(n[:, None]))[:, 0]
                 return np.concatenate([ndot, model.omega_dot(t, q, o)])
 
             return f
 
-        def event(t, y):
-            return y[0] * y[0] + y[1] * y[1] + y[2] * y[2] - thr2
-
-        event.terminal = True
-        event.direction = 1.0
-        order = np.argsort(np.abs(times), kind="stable")
-        ts = times[order]
-        qo = np.empty((4, times.size))
-        wo = np.empty((3, times.size))
-        qc = q0.copy()
-        y = np.r_[np.zeros(3), w0]
-        tcur = 0.0
-        tend = float(ts[-1])
-        k = 0
-        while True:
-            if tcur == tend:
-                nrem = times.size - k
-                ys = np.repeat(y[:, None], nrem, axis=1)
-                sol = None
-            else:
-                sol = self._call(make_rhs(qc), tcur, tend, y, rtol, atol, stats, events=event)
-                stop = float(sol.t[-1])
-                nrem = int(np.sum(np.abs(ts[k:]) <= abs(stop)))
-                ys = sol.sol(ts[k:k + nrem]) if nrem else np.empty((6, 0))
-            if nrem:
-                sel = order[k:k + nrem]
-                qq = ch.qmul(qc[:, None], ch.quaternion_from_gibbs(ys[:3]))
-                qo[:, sel] = qq / np.sqrt(ch.dot4(qq, qq))
-                wo[:, sel] = ys[3:]
-                k += nrem
-            if k >= times.size or sol is None:
-                break
-            ye = sol.y[:, -1]
-            qc = ch.qmul(qc[:, None], ch.quaternion_from_gibbs(ye[:3, None]))[:, 0]
-            qc = qc / np.sqrt(qc @ qc)
-            y = np.r_[np.zeros(3), ye[3:]]
-            tcur = stop
-            stats["chart_changes"] += 1
-        return qo, wo
+        tolerances = self._tolerances(w0 if np.any(w0) else self._rate_scale(model, q0), 3)
+        return self._charts(make_rhs, q0, w0, times, tolerances, stats)

@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 # pytest-xdist workers; 2 cores on CI
 WORKERS ?= auto
 
-.PHONY: demo test bench venv clean browser
+.PHONY: demo test bench venv clean browser mujoco
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -33,7 +33,15 @@ browser:
 	    echo "installed chromium for the browser test" ) || \
 	  echo "chromium is not available: the browser test will be skipped"
 
-test: $(VENV)/.installed-test browser
+# MuJoCo for the oracle's engine test (tests/test_oracle_mujoco.py): installed where possible,
+# otherwise that test is skipped with its reason.
+mujoco: $(VENV)/.installed-test
+	@$(BIN)/python -c "import mujoco" >/dev/null 2>&1 || \
+	  ( timeout 300 $(BIN)/python -m pip install --quiet mujoco >/dev/null 2>&1 && \
+	    echo "installed mujoco for the oracle test" ) || \
+	  echo "mujoco is not available: the MuJoCo oracle test will be skipped"
+
+test: $(VENV)/.installed-test browser mujoco
 	$(BIN)/python -m pytest -n $(WORKERS) -q
 
 # optional peers of the benchmark (heyoka, MuJoCo): installed where possible, skipped otherwise

@@ -1,0 +1,62 @@
+"""The figure of a validation: attitude error and invariant drift over time, log scale, exact flips marked."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["plot_report"]
+
+#: values below this are drawn at this level on the log axes (exact zeros have no logarithm)
+FLOOR = 1e-17
+
+
+def plot_report(report, out=None, *, title: str | None = None):
+    """Draw a :class:`~eulerpoisson.oracle.ValidationReport`.
+
+    Parameters
+    ----------
+    report : ValidationReport or sequence of (label, ValidationReport)
+        One report, or several (e.g. two integrators of one engine) drawn on the same axes.
+    out : str or os.PathLike, optional
+        Write the figure here (.png, .svg, .pdf).
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Raises
+    ------
+    MissingDependencyError
+        Without matplotlib (extra ``plot``).
+    """
+    from ..errors import require
+
+    require("matplotlib", "plot")
+    from matplotlib import rcParams
+    from matplotlib.figure import Figure  # no pyplot: no window, no global backend change
+
+    items = [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
+    fig = Figure(figsize=(8, 6.5), layout="constrained")
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
+    colors = rcParams["axes.prop_cycle"].by_key()["color"]
+    for n, (label, r) in enumerate(items):
+        c = colors[n % len(colors)]
+        ax1.semilogy(r.t, np.maximum(r.attitude_error, FLOOR), color=c, label=f"{label} (max {r.max_attitude_error:.2g} rad)")
+        ax2.semilogy(r.t, np.maximum(r.energy_error, FLOOR), color=c, label=f"{label}: energy")
+        ax2.semilogy(r.t, np.maximum(r.momentum_error, FLOOR), color=c, ls="--", label=f"{label}: |m - m0|/|m0|")
+        if r.tolerance is not None and n == 0:
+            ax1.axhline(r.tolerance, color="k", lw=0.8, ls=":", label=f"tolerance {r.tolerance:g} rad")
+    flips = items[0][1].flip_times or ()
+    for k, tf in enumerate(flips):
+        for ax in (ax1, ax2):
+            ax.axvline(tf, color="0.6", lw=0.8, ls="-.", label="exact flips" if (k == 0 and ax is ax1) else None)
+    ax1.set_ylabel("attitude error (rad)")
+    ax2.set_ylabel("relative drift of the run")
+    ax2.set_xlabel("t")
+    ax1.legend(fontsize=8, loc="lower right")
+    ax2.legend(fontsize=8, loc="lower right")
+    ax1.set_title(title or f"{items[0][1].source} against the exact motion")
+    if out is not None:
+        fig.savefig(out, dpi=110)
+    return fig

@@ -1004,6 +1004,9 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--quiet", action="store_true")
     d.set_defaults(func=cmd_demo)
 
+    from .oracle import add_commands  # validate, cases (issue 14)
+
+    add_commands(sub)
     return p
 
 

@@ -44,7 +44,6 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..numerics.quaternion import qmul_components
 from .body import RigidBody
-from .free_body import euler_coefficients
 from .torques import Gravity, GravityGradient, PolynomialTorque, Torque, as_torques
 
 __all__ = ["Model", "LagrangeTop", "as_model"]

@@ -41,9 +41,9 @@ gradient). A. V. Borisov and I. S. Mamaev, *Rigid Body Dynamics*, De Gruyter
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, ClassVar
+from collections.abc import Callable
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -580,6 +580,3 @@ def as_torques(torque) -> tuple[Torque, ...]:
         f"a callable torque(t, q, omega) -> tau_body, or a list of them; got {torque!r}"
     )
 
-
-def _unused():  # pragma: no cover - keeps math imported for numba-free builds
-    return math.pi

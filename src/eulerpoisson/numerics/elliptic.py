@@ -89,10 +89,8 @@ from ..errors import InvalidInputError
 from .doubledouble import dd_add as _dd_add
 from .doubledouble import dd_div as _dd_div
 from .doubledouble import dd_mul as _dd_mul
-from .doubledouble import dd_mul_d as _dd_mul_d
 from .doubledouble import dd_sqrt as _dd_sqrt
 from .doubledouble import quick_two_sum as _quick_two_sum
-from .doubledouble import split as _split
 from .doubledouble import two_prod as _two_prod
 from .doubledouble import two_sum as _two_sum
 

@@ -179,13 +179,6 @@ class Method:
             return None
         return f"it solves the free body only (the model has {model.describe()})"
 
-    def nominal_order(self) -> int | None:
-        """Nominal order of this configured instance (may depend on options such as ``scheme``)."""
-        return self.order
-
-    def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
-        raise NotImplementedError
-
 
 def register_method(cls: type[Method]) -> type[Method]:
     """Class decorator: register a :class:`Method` subclass under ``cls.name``."""

@@ -255,34 +255,11 @@ class Trajectory:
                 "has no output times (T = 0)"
             )
 
-        def rel(x, ref, scale):
-            s = np.where(scale > 0, scale, 1.0)
-            return np.max(np.abs(x - ref[..., None]), axis=-1) / s
+        from .model.drift import DriftAccumulator
 
-        if self.model.is_free:
-            E = self.energy
-            m = self.m
-            mn = np.linalg.norm(m, axis=-1)
-            out = {
-                "energy": rel(E, E[..., 0], np.abs(E[..., 0])),
-                "m_norm": rel(mn, mn[..., 0], mn[..., 0]),
-            }
-            for i, c in enumerate("xyz"):
-                out[f"m_{c}"] = rel(m[..., i], m[..., 0, i], mn[..., 0])
-        else:
-            vals = self.integrals()
-            mn0 = np.linalg.norm(self.m[..., 0, :], axis=-1)
-            kin0 = self.kinetic_energy[..., 0]
-            out = {}
-            for key, x in vals.items():
-                if key in ("energy", "jacobi"):
-                    scale = kin0 + np.abs(x[..., 0] - kin0)
-                elif key.startswith("m_") or key == "M3":
-                    scale = mn0
-                else:
-                    scale = np.abs(x[..., 0])
-                out[key] = rel(x, x[..., 0], scale)
-        return {k: (float(v) if np.ndim(v) == 0 else v) for k, v in out.items()}
+        acc = DriftAccumulator(self.model)  # the same computation as for long runs seen in pieces
+        acc.update(self.t, self.quaternion, self.omega)
+        return acc.result()
 
     def particles(self, center0=(0.0, 0.0, 0.0), velocity0=(0.0, 0.0, 0.0)) -> np.ndarray:
         r"""Positions of the body's point masses, :math:`\mathbf y_N(t) = \mathbf C_0 + \mathbf V_0 t + R(t)\mathbf x_N(0)` (paper eq. 1.2).
@@ -398,10 +375,24 @@ class Trajectory:
         MissingDependencyError
             If xarray or h5netcdf is missing (extra ``io``).
         """
+        import io
+
         ds = self.to_xarray()
         require("h5netcdf", "io")
+        # HDF5 writes into memory first; the file itself is written by plain Python I/O, so a full disk is
+        # an OSError naming the file (HDF5 left with a half-written file on a full disk crashed the
+        # interpreter at exit), and nothing is left behind
+        buf = io.BytesIO()
+        ds.to_netcdf(buf, engine="h5netcdf")
+        data = buf.getbuffer()
+        from .io.atomic import write_error
+
         with atomic_path(path) as tmp:
-            ds.to_netcdf(tmp, engine="h5netcdf")
+            try:
+                with open(tmp, "wb") as fh:
+                    fh.write(data)
+            except OSError as exc:
+                raise write_error(path, exc) from None
 
     @classmethod
     def from_netcdf(cls, path) -> "Trajectory":
@@ -447,7 +438,9 @@ class Trajectory:
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such file: {path}")
         try:
-            ds = xr.load_dataset(path, engine="h5netcdf")
+            from .io.read import netcdf_engine  # NetCDF-3 (classic) files through scipy, NetCDF-4 through h5netcdf
+
+            ds = xr.load_dataset(path, engine=netcdf_engine(path))
         except Exception as exc:
             raise EulerPoissonError(f"{path} is not a readable NetCDF file: {exc}") from exc
         ver = ds.attrs.get("eulerpoisson_format_version")
@@ -541,6 +534,27 @@ class Trajectory:
                     f"inertia @ omega by {err:.3g} (relative); the inertia or omega variable was modified"
                 )
         return traj
+
+    @classmethod
+    def open(cls, path):
+        """Open a trajectory file of any format eulerpoisson writes, by its content.
+
+        NetCDF-4 (:meth:`to_netcdf`) and NetCDF-3 classic files are read into
+        memory (:meth:`from_netcdf`); a Zarr store written by
+        ``simulate --out run.zarr`` (:func:`eulerpoisson.io.stream.solve_to_file`)
+        gives a :class:`eulerpoisson.io.read.LazyTrajectory`, which reads
+        the metadata and the first and last samples now and the others on
+        demand (``lazy[a:b]``,
+        ``lazy.iter_chunks()``, ``lazy.load()``; plots draw it chunk by chunk).
+
+        Raises
+        ------
+        TypeError, FileNotFoundError, EulerPoissonError, InvalidInputError, MissingDependencyError
+            As :func:`eulerpoisson.io.read.open_trajectory`.
+        """
+        from .io.read import open_trajectory
+
+        return open_trajectory(path)
 
     # ------------------------------------------------------------------
     # selecting and evaluating

@@ -472,7 +472,7 @@ LONG_RUN_STEPS = 100_000
 CHUNKS = 50
 
 
-def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
+def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: bool = True):
     """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
 
     The chunking depends only on the number of samples (never on whether a
@@ -480,7 +480,14 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
     closed form evaluates every chunk from the initial state (identical to one
     call); stepping methods continue each chunk from the last state of the
     previous one, as :func:`eulerpoisson.io.stream.solve_to_file` does.
+
+    ``keep=False`` (nothing is written): only the first and the last sample
+    are kept and the drift of the integrals is accumulated chunk by chunk,
+    so memory does not grow with the samples; returns ``(trajectory of those
+    two samples, drift)``.
     """
+    from ..model.drift import DriftAccumulator
+
     from ..solvers import get_method, solve
     from ..io.stream import ProgressDisplay, solve_from
     from ..trajectory import Trajectory
@@ -492,7 +499,9 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
         rate = float(np.max(np.linalg.norm(np.atleast_2d(omega0), axis=-1)))
         long_run = rate * float(np.max(np.abs(t))) / (8 * np.pi) > LONG_RUN_STEPS
     if t.size < CHUNKED_SAMPLES and not long_run:
-        return solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        tr = solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        return tr if keep else (tr, tr.drift())
+    acc = None if keep else DriftAccumulator(model)
     pieces = [p for p in np.array_split(np.arange(t.size), min(CHUNKS, t.size)) if p.size]
     qs, ws, wall = [], [], 0.0
     first = None
@@ -506,13 +515,23 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress):
                 tr = solve_from(model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :],
                                 method=method, **opts)
             first = tr if first is None else first
-            qs.append(tr.quaternion)
-            ws.append(tr.omega)
+            if acc is not None:
+                acc.update(tr.t, tr.quaternion, tr.omega)
+                if len(qs) > 1:  # keep the first chunk's first sample and the last chunk only
+                    qs.pop()
+                    ws.pop()
+            qs.append(tr.quaternion if acc is None or not qs else tr.quaternion[..., -1:, :])
+            ws.append(tr.omega if acc is None or not ws else tr.omega[..., -1:, :])
             qs_end_index = idx[-1]
             wall += tr.stats.get("wall_time", 0.0)
             done += idx.size
             bar.update(done)
     stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
+    if acc is not None:
+        ends = Trajectory(t[[0, -1]], np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
+                          np.concatenate([ws[0][..., :1, :], ws[-1][..., -1:, :]], axis=-2), first.body, method,
+                          first.options, stats, torque=list(model.torques))
+        return ends, acc.result()
     return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats,
                       torque=list(model.torques))
 
@@ -611,7 +630,8 @@ def cmd_simulate(args) -> int:
                          f"file or memory holds (a .zarr store of 1e8 samples is about 11 GB)")
     out_name = cfg.get("output.file")
     if not (isinstance(out_name, str) and out_name.endswith(".zarr")):
-        need = _memory_needed(samples, body.batch_shape)
+        # a run written to NetCDF is held in memory; one written nowhere keeps its ends and the times only
+        need = _memory_needed(samples, body.batch_shape) if out_name is not None else 16.0 * samples
         free = _memory_available()
         if free is not None and need > free:
             raise UsageError(
@@ -662,11 +682,14 @@ def cmd_simulate(args) -> int:
         traj.stats["wall_time"] = time.perf_counter() - start
     else:
         t = np.linspace(0.0, t_end, samples)
-        traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
-        if out is not None:
+        if out is None:  # nothing is written: keep the ends and the drift only (bounded memory)
+            traj, drift = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep=False)
+        else:
+            traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
             with OutputLock(out):
                 traj.to_netcdf(out)
-    drift = traj.drift()
+    if out is not None:
+        drift = traj.drift()
     if as_json:
         print(json.dumps(_state_json(traj, drift)))
     elif not args.quiet:
@@ -709,15 +732,18 @@ def cmd_audit(args) -> int:
 
 
 def _read_traj(path):
+    """The trajectory in ``path``: NetCDF-4 or NetCDF-3 (in memory), or a .zarr store (read lazily)."""
+    from ..io.read import file_format
     from ..trajectory import Trajectory
 
     _check_file_name(path, "trajectory file")
     if not os.path.exists(path):
         raise UsageError(f"{path}: no such file (write one with 'eulerpoisson simulate ... --out {path}')")
-    if os.path.isdir(path):
-        raise UsageError(f"{path} is a directory, not a trajectory file (NetCDF, written by 'eulerpoisson simulate --out')")
+    if os.path.isdir(path) and file_format(path) != "zarr":
+        raise UsageError(f"{path} is a directory, not a trajectory file (a NetCDF file or a .zarr store, written by "
+                         "'eulerpoisson simulate --out')")
     try:
-        return Trajectory.from_netcdf(path)
+        return Trajectory.open(path)
     except MissingDependencyError:
         raise
     except (EulerPoissonError, ValueError, TypeError, LookupError, AttributeError) as exc:
@@ -771,7 +797,11 @@ def cmd_animate(args) -> int:
     fps = _fps(args.fps) if args.fps is not None else 30
     traj = _read_traj(args.file)
     if video:
-        span = float(np.max(traj.t) - np.min(traj.t))
+        if getattr(traj, "lazy", False):  # a store: its ends (the times of a stream are monotonic)
+            ends = traj[[0, len(traj) - 1]] if len(traj) else traj.head()
+            span = float(np.max(ends.t) - np.min(ends.t))
+        else:
+            span = float(np.max(traj.t) - np.min(traj.t))
         nframes = int(round(fps * default_duration(span)))
         if nframes > MAX_FRAMES:
             dur = default_duration(span)
@@ -785,8 +815,40 @@ def cmd_animate(args) -> int:
     return 0
 
 
+def _info_store(args, traj) -> int:
+    """``info`` of a .zarr store: its metadata and its first and last samples, nothing else is read."""
+    b = traj.body
+    lines = [
+        f"{args.file}: eulerpoisson trajectory (Zarr store, read lazily: {traj.chunk} samples per chunk)",
+        f"  method      {traj.method} {json.dumps(traj.options) if traj.options else ''}".rstrip(),
+        f"  torque      {traj.model.describe()}",
+    ]
+    if len(traj) == 0:
+        lines.append("  samples     0 (no output times)")
+        lines.append(f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}")
+        print("\n".join(lines))
+        return 0
+    first, last = traj.head(), traj.tail()
+    lines.append(f"  samples     {len(traj)}, t from {float(first.t[0]):.6g} to {float(last.t[0]):.6g}")
+    lines.append(f"  variables   {', '.join(traj.variables)}")
+    if traj.batch_shape:
+        lines.append(f"  bodies      batch of shape {traj.batch_shape}")
+    else:
+        lines.append(f"  body        {b!r}")
+        lines.append(f"  energy      {float(first.energy[0]):.15g}"
+                     + ("" if traj.model.is_free else " (kinetic + potential)"))
+        lines.append(f"  m           {np.round(first.m[0], 12).tolist()}")
+    drift = traj.drift_endpoints()
+    lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in drift.items())
+                 + " (last sample against the first)")
+    print("\n".join(lines))
+    return 0
+
+
 def cmd_info(args) -> int:
     traj = _read_traj(args.file)
+    if getattr(traj, "lazy", False):
+        return _info_store(args, traj)
     b = traj.body
     lines = [
         f"{args.file}: eulerpoisson trajectory",
@@ -951,9 +1013,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="draw a figure from a trajectory file",
         formatter_class=ex,
         epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf\n"
-               "  eulerpoisson plot top.nc --kind apex --out apex.png   # a top: its axis on the unit sphere",
+               "  eulerpoisson plot top.nc --kind apex --out apex.png   # a top: its axis on the unit sphere\n"
+               "  eulerpoisson plot long.zarr --kind omega --out omega.png   # a streamed run: min/max per pixel column\n\n"
+               "Long runs (more than 20000 samples, and every .zarr store) are decimated: time series are drawn as\n"
+               "the min/max of the samples in each pixel column, the 3-D pictures from evenly strided samples.",
     )
-    pl.add_argument("file", help="trajectory NetCDF file written by 'simulate --out' (or a sweep store for --kind atlas)")
+    pl.add_argument("file", help="trajectory written by 'simulate --out': a NetCDF file (version 4 or 3) or a .zarr "
+                    "store, read chunk by chunk (or a sweep store for --kind atlas)")
     pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "apex", "atlas"])
     pl.add_argument("--out", help="figure file (.png, .svg or .pdf)")
     pl.add_argument("--quiet", action="store_true")
@@ -965,7 +1031,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=ex,
         epilog="examples:\n  eulerpoisson animate run.nc --out movie.html\n  eulerpoisson animate run.nc --out movie.gif",
     )
-    an.add_argument("file", help="trajectory NetCDF file")
+    an.add_argument("file", help="trajectory file: NetCDF (version 4 or 3) or a .zarr store")
     an.add_argument("--out", required=True, help="movie.html, movie.gif or movie.mp4")
     an.add_argument("--fps", help=f"frames per second of a .gif/.mp4 ({FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}, default 30)")
     an.add_argument("--quiet", action="store_true")
@@ -990,8 +1056,10 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("--quiet", action="store_true")
     sw.set_defaults(func=cmd_sweep)
 
-    i = sub.add_parser("info", help="describe a trajectory file", epilog="example:\n  eulerpoisson info run.nc", formatter_class=ex)
-    i.add_argument("file")
+    i = sub.add_parser("info", help="describe a trajectory file", formatter_class=ex,
+                       epilog="examples:\n  eulerpoisson info run.nc\n  eulerpoisson info long.zarr   # a store: only its "
+                              "metadata and its first and last samples are read")
+    i.add_argument("file", help="trajectory file: NetCDF (version 4 or 3) or a .zarr store")
     i.set_defaults(func=cmd_info)
 
     d = sub.add_parser(

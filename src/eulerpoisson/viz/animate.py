@@ -11,8 +11,9 @@ which is fixed in space for the free body.
   on a ``<canvas>`` with a small hand-written perspective projection
   (back-face culling, painter's algorithm, Lambert-shaded faces). The page
   has a play/pause button, a time slider, and drag-to-rotate for the view.
-* ``.gif`` — rendered with matplotlib's ``PillowWriter`` (Pillow is a
-  dependency of matplotlib).
+* ``.gif`` — rendered by matplotlib and streamed to the file frame by frame
+  (:class:`GifStreamWriter`, with Pillow, a dependency of matplotlib): memory
+  is bounded by two frames whatever their number.
 * ``.mp4`` — rendered with matplotlib's ``FFMpegWriter``; needs the
   ``ffmpeg`` program.
 
@@ -32,9 +33,11 @@ inertia of a box).
 
 from __future__ import annotations
 
+import contextlib
 import html as _html
 import json
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -43,9 +46,9 @@ import numpy as np
 from ..io.atomic import atomic_path
 from ..util.validate import as_float_array
 from ..errors import InvalidInputError, MissingDependencyError
-from .plots import AXIS_COLORS, import_matplotlib, select_body
+from .plots import AXIS_COLORS, import_matplotlib, plain_text, select_body
 
-__all__ = ["animate", "box_dimensions", "slerp_series", "FORMATS"]
+__all__ = ["animate", "box_dimensions", "slerp_series", "FORMATS", "GifStreamWriter"]
 
 #: output formats of :func:`animate`, by file extension
 FORMATS = ("html", "gif", "mp4")
@@ -303,8 +306,10 @@ def animate(traj, out, *, fps=30, duration=None, index=0, size=(640, 480),
 
     Parameters
     ----------
-    traj : Trajectory
-        The motion (for a batch, the body ``index`` is shown).
+    traj : Trajectory or LazyTrajectory
+        The motion (for a batch, the body ``index`` is shown). A Zarr store
+        (:class:`~eulerpoisson.io.read.LazyTrajectory`) is read at
+        ``max(max_samples, 80000)`` evenly spread samples, each chunk once.
     out : str or path
         Output file; ``.html`` (a self-contained page), ``.gif`` or ``.mp4``.
     fps : float
@@ -343,6 +348,12 @@ def animate(traj, out, *, fps=30, duration=None, index=0, size=(640, 480),
     >>> tr = ep.solve([3, 5, 7], np.linspace(0, 150, 3001), omega0=[0, 0.4, 0.01 / 7])  # doctest: +SKIP
     >>> animate(tr, "racket.html")                                                   # doctest: +SKIP
     """
+    from ..io.read import LazyTrajectory
+
+    if isinstance(traj, LazyTrajectory):  # a store: evenly spread samples, each Zarr chunk read once
+        n = len(traj)
+        keep = max(int(max_samples), 4 * MAX_HTML_SAMPLES)
+        traj = traj.gather(np.unique(np.round(np.linspace(0, n - 1, min(n, keep))).astype(np.int64)))
     one = select_body(traj, index)
     p, ext, px = _check_args(out, fps, duration, size)
     span = float(one.t[-1] - one.t[0])
@@ -400,16 +411,19 @@ def _html_page(one, sides, verts, faces, mdir, duration, px, max_samples) -> str
     blob = blob.replace("&", "\\u0026").replace("<", "\\u003c").replace(">", "\\u003e")
     w, h = px
     moms = ", ".join(f"I{i + 1} = {v:.4g}" for i, v in enumerate(one.moments))
-    page = _TEMPLATE
-    for key, val in (
-        ("__TITLE__", _html.escape(title)),
-        ("__MOMENTS__", _html.escape(moms)),
-        ("__W__", str(w)),
-        ("__H__", str(h)),
-        ("__DATA__", blob),
-    ):
-        page = page.replace(key, val)
-    return page
+    values = {
+        "TITLE": _html.escape(title),
+        "MOMENTS": _html.escape(moms),
+        "W": str(w),
+        "H": str(h),
+        "DATA": blob,
+    }
+    # one pass over the template: the substituted text (a body name may contain "__DATA__") is never
+    # searched for placeholders again
+    return _PLACEHOLDER.sub(lambda mt: values[mt.group(1)], _TEMPLATE)
+
+
+_PLACEHOLDER = re.compile(r"__(TITLE|MOMENTS|W|H|DATA)__")
 
 
 _TEMPLATE = r"""<!DOCTYPE html>
@@ -660,11 +674,114 @@ space. Drag to turn the view.</div>
 # ---------------------------------------------------------------------------
 # GIF / MP4
 # ---------------------------------------------------------------------------
+class GifStreamWriter:
+    """Write a GIF frame by frame as the frames are drawn: memory bounded by one frame, whatever their number.
+
+    matplotlib's ``PillowWriter`` keeps every frame (as RGBA) until the end
+    and hands them to Pillow at once: 600 frames of 640×480 took 1 GB. Here
+    every frame is quantized to its own palette of at most 256 colours
+    (Pillow's fast octree; no dithering) and written at once, cropped to the
+    rectangle where it differs from the previous frame; a frame identical to
+    the previous one lengthens the previous one's display time instead. The
+    file is a GIF89a that loops forever, with a local colour table per frame.
+    Only the previous frame (and the one waiting to be written) is kept.
+
+    The interface is that of a matplotlib movie writer: ``with
+    writer.saving(fig, path, dpi): ... writer.grab_frame()``.
+    """
+
+    def __init__(self, fps):
+        self.fps = float(fps)
+        self._fh = None
+
+    @contextlib.contextmanager
+    def saving(self, fig, outfile, dpi):
+        self.setup(fig, outfile, dpi)
+        try:
+            yield self
+        finally:
+            self.finish()
+
+    def setup(self, fig, outfile, dpi):
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+        self.fig = fig
+        if not isinstance(fig.canvas, FigureCanvasAgg):
+            FigureCanvasAgg(fig)
+        fig.set_dpi(dpi)
+        self._fh = open(outfile, "wb")
+        self._prev = None  # the previous frame (RGB array)
+        self._pending = None  # (P image, offset, duration in ms): written when the next frame differs
+        self._size = None
+        self.frames = 0
+
+    def _header(self, w, h) -> bytes:
+        import struct
+
+        # logical screen without a global colour table (every frame has its own), then the loop extension
+        return (b"GIF89a" + struct.pack("<HHBBB", w, h, 0, 0, 0)
+                + b"!\xff\x0bNETSCAPE2.0\x03\x01" + struct.pack("<H", 0) + b"\x00")
+
+    def grab_frame(self, **savefig_kwargs):
+        self.fig.canvas.draw()
+        rgb = np.asarray(self.fig.canvas.buffer_rgba())[..., :3]
+        self.add_frame(rgb)
+
+    def add_frame(self, rgb) -> None:
+        """Add one frame, an (h, w, 3) uint8 array."""
+        from PIL import Image
+
+        rgb = np.ascontiguousarray(rgb, dtype=np.uint8)
+        h, w = rgb.shape[:2]
+        duration = 1000.0 / self.fps
+        if self._size is None:
+            self._size = (w, h)
+            self._fh.write(self._header(w, h))
+            box = (0, 0, w, h)
+        else:
+            if (w, h) != self._size:
+                raise InvalidInputError(f"GIF frames must all have the size {self._size}, got {(w, h)}")
+            diff = np.any(rgb != self._prev, axis=2)
+            rows = np.flatnonzero(diff.any(axis=1))
+            if rows.size == 0:  # the same picture: show the previous frame longer
+                im, off, d = self._pending
+                self._pending = (im, off, d + duration)
+                return
+            cols = np.flatnonzero(diff.any(axis=0))
+            box = (int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1)
+        self._flush()
+        part = Image.fromarray(rgb[box[1]:box[3], box[0]:box[2]], "RGB")
+        pim = part.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
+        self._pending = (pim, box[:2], duration)
+        self._prev = rgb.copy()
+        self.frames += 1
+
+    def _flush(self) -> None:
+        from PIL import GifImagePlugin
+
+        if self._pending is None:
+            return
+        im, off, d = self._pending
+        for part in GifImagePlugin.getdata(im, offset=off, duration=int(round(d)), include_color_table=True):
+            self._fh.write(part)
+        self._pending = None
+
+    def finish(self):
+        if self._fh is None:
+            return
+        try:
+            self._flush()
+            self._fh.write(b";")
+        finally:
+            self._fh.close()
+            self._fh = None
+
+
 def _writer(ext, fps):
     from matplotlib import animation
 
     if ext == "gif":
-        return animation.PillowWriter(fps=fps)
+        return GifStreamWriter(fps=fps)
     if not animation.FFMpegWriter.isAvailable():
         import matplotlib
 
@@ -738,7 +855,8 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
                              marker="o", s=16, zorder=3, depthshade=False)
             ax.text(*(1.04 * arrow * mdir + 0.1 * lim * cam[1]), "m", color="#111111", zorder=3, ha="center",
                     va="center", fontsize=11)
-        fig.text(0.5, 0.965, one.label + " — " + one.method, ha="center", va="center", fontsize=10)
+        # names are text: no mathtext ($...$ in a body name is drawn as typed)
+        fig.text(0.5, 0.965, plain_text(one.label + " — " + one.method), ha="center", va="center", fontsize=10)
         ttext = fig.text(0.5, 0.925, "", ha="center", va="center", fontsize=9, color="#444444")
         Rf = matrix_from_unit_quaternion(qf)
         with atomic_path(out, suffix="." + ext) as tmp:
@@ -766,6 +884,6 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
                     if tip is not None:
                         tip.set_visible(not hidden_by_box((arrow * mdir)[None], Rk, half, one.axes,
                                                           towards_viewer, orthographic=True)[0])
-                    ttext.set_text(f"t = {tf[k]:.2f} {one.time_unit}")
+                    ttext.set_text(plain_text(f"t = {tf[k]:.2f} {one.time_unit}"))
                     writer.grab_frame()
     return out

@@ -46,6 +46,25 @@ Conventions of the pictures
   objects, never through ``pyplot``: no window is opened and no global
   backend is changed; saving uses the Agg (png) / svg / pdf renderers.
 
+Long runs and Zarr stores
+-------------------------
+Every function takes a :class:`~eulerpoisson.trajectory.Trajectory` or a
+:class:`~eulerpoisson.io.read.LazyTrajectory` (a ``.zarr`` store written by
+``simulate --out run.zarr``, opened by :meth:`Trajectory.open
+<eulerpoisson.trajectory.Trajectory.open>`). A time series of more than
+:data:`DECIMATE_ABOVE` samples (``omega``, ``invariants``) is drawn as the
+minimum and maximum of the samples in each of 2000 columns
+(:class:`~eulerpoisson.viz.decimate.MinMaxEnvelope`), computed piece by piece
+(a store is read chunk by chunk, only the variables needed): the drawn
+envelope contains every sample, and memory does not grow with the run. The
+3-D pictures draw evenly strided samples (20 000, 40 000 for ``apex``); a
+store longer than :data:`MAX_READ_3D` samples is read in whole chunks evenly
+spread over the run, so that a picture of :math:`10^8` samples costs what one
+of :math:`10^7` does. ``gibbs`` splits at most a million samples into charts
+(in linear time) and draws at most :data:`MAX_CHARTS` of them, evenly chosen.
+Names (of the body, of the method) are drawn as text, never as mathtext
+(:func:`plain_text`).
+
 The Gibbs-vector picture and chart restarts
 -------------------------------------------
 The global Gibbs vector :math:`\mathbf n = \mathbf k\tan(\alpha/2)` (paper
@@ -81,7 +100,7 @@ import numpy as np
 
 from ..io.atomic import atomic_path
 from ..attitude.core import matrix_from_unit_quaternion
-from ..numerics.quaternion import qmul
+from ..numerics.quaternion import qmul, qmul_components
 from ..errors import InvalidInputError, require
 
 __all__ = [
@@ -99,6 +118,9 @@ __all__ = [
     "apex_axis",
     "chart_segments",
     "sphere_conic",
+    "plain_text",
+    "DECIMATE_ABOVE",
+    "MAX_CHARTS",
 ]
 
 #: picture kinds accepted by :func:`plot`
@@ -241,8 +263,18 @@ def select_body(traj, index=0) -> _One:
     )
 
 
+def plain_text(text: str) -> str:
+    r"""``text`` as matplotlib draws it literally: every ``$`` escaped (``\$``), so no mathtext.
+
+    A body name (or a method name read from a file) is text: ``"$x^2$ rod"``
+    must be drawn as typed, not parsed as mathematics (which fails on names
+    that are not valid TeX, and changes those that are).
+    """
+    return str(text).replace("$", r"\$")
+
+
 def _title(one: _One, what: str) -> str:
-    return f"{what}\n{one.label} — method: {one.method}"
+    return f"{what}\n{plain_text(one.label)} — method: {plain_text(one.method)}"
 
 
 def import_matplotlib():
@@ -310,6 +342,164 @@ def _setup_3d(ax, lim, labels, elev=22, azim=38):
 
 
 # ---------------------------------------------------------------------------
+# long runs: decimated time series, thinned paths, stores read chunk by chunk
+# ---------------------------------------------------------------------------
+#: time series with more samples than this are drawn as min/max envelopes per pixel column
+DECIMATE_ABOVE = 20_000
+#: samples per piece when a long run is walked through (in memory or in a Zarr store)
+_PIECE = 1_000_000
+#: most samples a long run is thinned to before the Gibbs vector is split into charts
+_MAX_GIBBS_SAMPLES = 1_000_000
+#: most chart segments drawn by plot_gibbs (evenly chosen among all of them)
+MAX_CHARTS = 200
+
+
+def _is_lazy(traj) -> bool:
+    """A trajectory read on demand (:class:`eulerpoisson.io.read.LazyTrajectory`)."""
+    from ..io.read import LazyTrajectory
+
+    return isinstance(traj, LazyTrajectory)
+
+
+def _is_long(traj) -> bool:
+    _check_traj(traj)
+    return _is_lazy(traj) or len(traj.t) > DECIMATE_ABOVE
+
+
+def _check_traj(traj) -> None:
+    from ..trajectory import Trajectory
+
+    if not (isinstance(traj, Trajectory) or _is_lazy(traj)):
+        raise TypeError(f"traj must be an eulerpoisson Trajectory, got {type(traj).__name__}")
+
+
+def _batch_index(bshape, index) -> tuple:
+    """The batch index of the body ``index`` (validated by :func:`select_body`)."""
+    if not bshape:
+        return ()
+    if isinstance(index, tuple):
+        return tuple(int(i) % n for i, n in zip(index, bshape))
+    return tuple(int(i) for i in np.unravel_index(int(index) % int(np.prod(bshape)), bshape))
+
+
+def _ends(traj, index) -> _One:
+    """The body ``index`` at the first and last samples of a long run (labels, inertia, time range)."""
+    from ..trajectory import Trajectory
+
+    _check_traj(traj)
+    T = len(traj.t) if not _is_lazy(traj) else len(traj)
+    if T < 2:
+        return select_body(traj if not _is_lazy(traj) else traj.load(), index)
+    if _is_lazy(traj):
+        ends = traj[[0, T - 1]]
+    else:  # (indexing would build an index array of the run's length)
+        ends = Trajectory(traj.t[[0, T - 1]], traj.quaternion[..., [0, T - 1], :], traj.omega[..., [0, T - 1], :],
+                          traj.body, traj.method, traj.options, traj.stats, torque=list(traj.model.torques))
+    one = select_body(ends, index)
+    if not _is_lazy(traj):  # in memory: the true time range (the times may be in any order)
+        one.t = np.array([float(np.min(traj.t)), float(np.max(traj.t))])
+    one.first = 0 if ends.t[0] <= ends.t[-1] or _is_lazy(traj) else 1
+    return one
+
+
+def _body_pieces(traj, idx, names=("time", "quaternion", "omega"), size: int = _PIECE):
+    """Dicts of the arrays ``names`` of body ``idx``, piece by piece (bounded memory; a store reads only those)."""
+    if _is_lazy(traj):
+        for piece in traj.iter_arrays(names, size):
+            yield {k: (v if k == "time" else v[idx]) for k, v in piece.items()}
+        return
+    q, w = traj.quaternion[idx], traj.omega[idx]
+    for a in range(0, len(traj.t), size):  # in memory: views, and the state only
+        yield {"time": traj.t[a:a + size], "quaternion": q[a:a + size], "omega": w[a:a + size]}
+
+
+def _envelope(traj, index, k: int, values, nbins=None, names=("time", "quaternion", "omega")):
+    """Min/max envelope of ``values(piece, one) -> (n, k)`` over the run, computed piece by piece.
+
+    Returns ``(one, env)``: the body at the ends (:func:`_ends`) and the
+    :class:`~eulerpoisson.viz.decimate.MinMaxEnvelope`.
+    """
+    from .decimate import DEFAULT_BINS, MinMaxEnvelope
+
+    one = _ends(traj, index)
+    idx = _batch_index(traj.batch_shape, index)
+    t0, t1 = float(np.min(one.t)), float(np.max(one.t))
+    for _ in range(2):  # a store whose times are not monotonic: a second pass over the true range
+        env = MinMaxEnvelope(t0, t1, k, nbins or DEFAULT_BINS)
+        lo, hi = t0, t1
+        for piece in _body_pieces(traj, idx, names):
+            t = piece["time"]
+            lo, hi = min(lo, float(np.min(t))), max(hi, float(np.max(t)))
+            env.add(t, values(piece, one))
+        if lo >= t0 and hi <= t1:
+            break
+        t0, t1 = lo, hi
+    one.t = np.array([t0, t1])
+    return one, env
+
+
+#: most samples read from a store for a 3-D picture (whole Zarr chunks, evenly spread over the run)
+MAX_READ_3D = 10_000_000
+
+
+def _thin(traj, limit: int, *, blocks: bool = False):
+    """At most about ``limit`` evenly strided samples (the first one kept), as an in-memory Trajectory.
+
+    A store is read piece by piece; one longer than :data:`MAX_READ_3D`
+    samples is read in whole Zarr chunks evenly spread over the run (the
+    3-D pictures are point samples of a path: the time for a picture stays
+    bounded at any length). With ``blocks=True`` also the start positions,
+    in the result, of its contiguous runs of samples (the joins are gaps in time).
+    """
+    from ..trajectory import Trajectory
+
+    _check_traj(traj)
+    if not _is_lazy(traj):
+        T = len(traj.t)
+        if T > limit:
+            step = -(-T // limit)
+            traj = Trajectory(traj.t[::step], traj.quaternion[..., ::step, :], traj.omega[..., ::step, :],
+                              traj.body, traj.method, traj.options, traj.stats, torque=list(traj.model.torques))
+        return (traj, [0]) if blocks else traj
+    T = len(traj)
+    chunks = traj.chunk_bounds()
+    if T > MAX_READ_3D and len(chunks) > 1:
+        keep = max(1, MAX_READ_3D // traj.chunk)
+        chunks = [chunks[i] for i in np.unique(np.round(np.linspace(0, len(chunks) - 1, keep)).astype(int))]
+    total = sum(b - a for a, b in chunks)
+    step = max(1, -(-total // limit))
+    # contiguous runs of the chosen chunks, read in pieces of at most _PIECE samples
+    runs = []
+    for a, b in chunks:
+        if runs and runs[-1][1] == a:
+            runs[-1][1] = b
+        else:
+            runs.append([a, b])
+    ranges, starts, pos = [], [], 0
+    for a, b in runs:
+        starts.append(pos)
+        for c in range(a, b, _PIECE):
+            d = min(b, c + _PIECE)
+            c0 = a + -(-(c - a) // step) * step  # the stride continues across pieces of a run
+            if c0 < d:
+                ranges.append((c0, d, step))
+                pos += len(range(c0, d, step))
+    parts = [traj.read_arrays(("time", "quaternion", "omega"), *r) for r in ranges]
+    if not parts:
+        return (traj.load(), [0]) if blocks else traj.load()
+    out = Trajectory(np.concatenate([p["time"] for p in parts]),
+                     np.concatenate([p["quaternion"] for p in parts], axis=-2),
+                     np.concatenate([p["omega"] for p in parts], axis=-2), traj.body, traj.method, traj.options,
+                     traj.stats, torque=list(traj.model.torques))
+    return (out, starts) if blocks else out
+
+
+def _decimated_note(ax, n: int) -> None:
+    ax.text(0.005, 0.005, f"{n:,} samples: min/max per pixel column", transform=ax.transAxes, ha="left",
+            va="bottom", fontsize=7, color="0.45")
+
+
+# ---------------------------------------------------------------------------
 # omega
 # ---------------------------------------------------------------------------
 def plot_omega(traj, ax=None, fig=None, *, index=0, **style):
@@ -343,12 +533,19 @@ def plot_omega(traj, ax=None, fig=None, *, index=0, **style):
     MissingDependencyError
         matplotlib is not installed (extra ``plot``).
     """
-    one = select_body(traj, index)
+    if _is_long(traj):  # min/max per pixel column, computed piece by piece
+        one, env = _envelope(traj, index, 3, lambda piece, one: piece["omega"], names=("time", "omega"))
+        x, y = env.points()
+    else:
+        one = select_body(traj, index)
+        x, y = one.t, one.omega
     mpl = import_matplotlib()
     with mpl.rc_context(STYLE):
         fig, ax = _new_axes(ax, fig, False, (7.0, 3.8))
         for i in range(3):
-            ax.plot(one.t, one.omega[:, i], color=AXIS_COLORS[i], label=f"Ω{str(i + 1).translate(_SUB)}", **style)
+            ax.plot(x, y[:, i], color=AXIS_COLORS[i], label=f"Ω{str(i + 1).translate(_SUB)}", **style)
+        if _is_long(traj):
+            _decimated_note(ax, env.samples)
         ax.axhline(0.0, color="0.3", lw=0.6)
         ax.set_xlabel(f"time t [{one.time_unit}]")
         ax.set_ylabel(f"body angular velocity Ω [rad/{one.time_unit}]")
@@ -383,6 +580,58 @@ def invariant_drift(one: _One) -> dict[str, np.ndarray]:
     return out
 
 
+def _drift_values(traj, index):
+    """``values(t, q, omega, one)`` of the five drift curves of :func:`invariant_drift`, for :func:`_envelope`."""
+    from ..trajectory import Trajectory
+
+    first = traj[0] if _is_lazy(traj) else Trajectory(traj.t[:1], traj.quaternion[..., :1, :], traj.omega[..., :1, :],
+                                                      traj.body)
+    ref = select_body(Trajectory(np.array([0.0, 1.0]), np.repeat(first.quaternion, 2, axis=-2),
+                                 np.repeat(first.omega, 2, axis=-2), first.body), index)
+    E0 = float(ref.energy[0])
+    m0 = ref.m[0]
+    mn0 = float(np.linalg.norm(m0))
+
+    def rel(x, r, scale):
+        return np.abs(x - r) / (scale if scale > 0 else 1.0)
+
+    # a store keeps m (and, for the free body, the energy): read those instead of computing them
+    stored = set(getattr(traj, "variables", ()))
+    use_m = _is_lazy(traj) and "m" in stored
+    use_E = use_m and "energy" in stored and traj.model.is_free
+    names = ("time",) + (("m",) if use_m else ("quaternion",)) + (("energy",) if use_E else ("omega",))
+
+    def values(piece, one):
+        if use_m:
+            m = piece["m"]
+        else:
+            q, w = piece["quaternion"], piece["omega"]
+            m = _rotate(q, w @ one.inertia.T)
+        if use_E:
+            E = piece["energy"]
+        else:
+            w = piece["omega"]
+            M = w @ one.inertia.T
+            E = 0.5 * (w[:, 0] * M[:, 0] + w[:, 1] * M[:, 1] + w[:, 2] * M[:, 2])
+        m1, m2, m3 = m[:, 0], m[:, 1], m[:, 2]
+        mn = np.sqrt(m1 * m1 + m2 * m2 + m3 * m3)  # (a reduction over a short last axis is slow)
+        out = np.empty((m.shape[0], 5))
+        out[:, 0] = rel(E, E0, abs(E0))
+        out[:, 1] = rel(mn, mn0, mn0)
+        for i in range(3):
+            out[:, 2 + i] = rel(m[:, i], m0[i], mn0)
+        return out
+
+    return values, names
+
+
+def _rotate(q, v):
+    """``R(q) v`` for unit quaternions (n, 4) and vectors (n, 3), without forming the matrices."""
+    w, u = q[:, :1], q[:, 1:]
+    tt = 2.0 * np.cross(u, v)
+    return v + w * tt + np.cross(u, tt)
+
+
 def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
     r"""Relative drift of the integrals of motion on a log scale.
 
@@ -408,10 +657,18 @@ def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
     TypeError, InvalidInputError, MissingDependencyError
         As for :func:`plot_omega`.
     """
-    one = select_body(traj, index)
+    long = _is_long(traj)
+    if long:
+        values, names = _drift_values(traj, index)
+        one, env = _envelope(traj, index, 5, values, names=names)
+        x, y = env.points()
+        curves = {key: y[:, i] for i, key in enumerate(("E", "|m|", "m₁", "m₂", "m₃"))}
+    else:
+        one = select_body(traj, index)
+        x = one.t
+        curves = invariant_drift(one)
     mpl = import_matplotlib()
     eps = np.finfo(float).eps
-    curves = invariant_drift(one)
     colors = {"E": "k", "|m|": "#9467bd"}
     with mpl.rc_context(STYLE):
         fig, ax = _new_axes(ax, fig, False, (7.0, 3.8))
@@ -419,11 +676,13 @@ def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
         for i, (key, y) in enumerate(curves.items()):
             color = colors.get(key, AXIS_COLORS[(i - 2) % 3])
             base = {"lw": 1.4, "zorder": 3} if i < 2 else {"lw": 0.8, "alpha": 0.8, "zorder": 2}
-            ax.semilogy(one.t, np.maximum(y, eps), color=color, label=key, **{**base, **style})
+            ax.semilogy(x, np.maximum(y, eps), color=color, label=key, **{**base, **style})
+        if long:
+            _decimated_note(ax, env.samples)
         ax.axhline(eps, color="0.5", lw=0.8, ls=":")
         ax.annotate("machine ε", (1.0, eps), xycoords=("axes fraction", "data"), xytext=(-4, -3),
                     textcoords="offset points", ha="right", va="top", fontsize=8, color="0.4")
-        top = max(float(np.max([np.max(y) for y in curves.values()])), 1e3 * eps)
+        top = max(float(np.nanmax([np.nanmax(y) for y in curves.values()])), 1e3 * eps)
         ax.set_ylim(eps / 4, top * 60)  # room for the legend above the curves
         ax.set_xlim(one.t[0], one.t[-1])
         ax.set_xlabel(f"time t [{one.time_unit}]")
@@ -560,6 +819,7 @@ def plot_polhode(traj, ax=None, fig=None, *, index=0, family=4, **style):
     TypeError, InvalidInputError, MissingDependencyError
         As for :func:`plot_omega`.
     """
+    traj = _thin(traj, _MAX_3D_POINTS)  # a long run (or a store): evenly strided, read piece by piece
     one = select_body(traj, index)
     mpl = import_matplotlib()
     Mp = one.M @ one.axes  # principal components P^T M, (T, 3)
@@ -661,31 +921,106 @@ def chart_segments(q, chart_radius=1.0, *, jump_limit=4.0):
         raise InvalidInputError(f"chart_radius must be positive and finite, got {chart_radius!r}")
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
     conj = np.array([1.0, -1.0, -1.0, -1.0])
+    bounds = _chart_bounds(q, r, float(jump_limit))
+    if not bounds:
+        return []
+    # the local vectors of all charts at once: q_ref^-1 q for every sample of every chart
+    starts = np.array([a for a, _ in bounds])
+    lens = np.array([b - a for a, b in bounds])
+    idx_all = np.concatenate([np.arange(a, b) for a, b in bounds])
+    rel = qmul(np.repeat(q[starts] * conj, lens, axis=0), q[idx_all])
+    first = np.concatenate([[0], np.cumsum(lens)[:-1]])
+    rel[first] = (1.0, 0.0, 0.0, 0.0)  # the chart centres, exactly (q_ref^-1 q_ref rounds to it)
+    n_all = rel[:, 1:] / rel[:, :1]
+    cut = np.cumsum(lens)[:-1]
+    return list(zip(np.split(idx_all, cut), np.split(n_all, cut), q[starts]))
+
+
+def _chart_bounds_numpy(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
+    """``(start, end)`` of every chart of :func:`chart_segments` (numpy, in windows that double)."""
+    conj = np.array([1.0, -1.0, -1.0, -1.0])
     T = q.shape[0]
-    segs = []
+    out = []
     start = 0
+    window = 64
     while start < T:
-        ref = q[start]
-        rel = qmul(ref * conj, q[start:])
-        rel[0] = (1.0, 0.0, 0.0, 0.0)  # the chart centre, exactly (q_ref^-1 q_ref rounds to it)
-        w = rel[:, 0]
-        v = rel[:, 1:]
-        # |n| > r  <=>  |v| > r |w|  (no division: w may be 0)
-        out = np.linalg.norm(v, axis=1) > r * np.abs(w)
-        hit = np.flatnonzero(out)
-        if hit.size == 0:
-            idx = np.arange(start, T)
-            segs.append((idx, v / w[:, None], ref))
+        ref = q[start] * conj
+        # the chart's samples are examined in windows that double until the chart is left: the work
+        # is proportional to the samples of the chart (not to all the samples after it, which made the
+        # split quadratic in the length of the run)
+        stop = start
+        h = -1
+        while stop < T:
+            lo, stop = stop, min(T, stop + window)
+            seg = q[lo:stop]
+            w, x, y, z = qmul_components(ref[0], ref[1], ref[2], ref[3], seg[:, 0], seg[:, 1], seg[:, 2], seg[:, 3])
+            # |n| > r  <=>  |v| > r |w|  (no division: w may be 0); the centre itself is never out
+            out_ = np.sqrt(x * x + y * y + z * z) > r * np.abs(w)
+            if lo == start:
+                out_[0] = False
+            hit = np.flatnonzero(out_)
+            if hit.size:
+                k = int(hit[0])
+                h = lo - start + k
+                big = np.sqrt(x[k] ** 2 + y[k] ** 2 + z[k] ** 2) > jump_limit * r * abs(w[k])
+                break
+            window *= 2
+        if h < 0:
+            out.append((start, T))
             break
-        h = int(hit[0])
-        big = np.linalg.norm(v[h]) > jump_limit * r * abs(w[h])
-        end = h if big else h + 1  # exclusive, relative
-        idx = np.arange(start, start + end)
-        segs.append((idx, v[:end] / w[:end, None], ref))
-        start = start + h
-        if big and h == 0:  # pragma: no cover - cannot happen: n_loc(ref) = 0
-            start += 1
-    return segs
+        window = max(64, 2 * (h + 1))
+        out.append((start, start + (h if big else h + 1)))
+        start += h
+    return out
+
+
+def _chart_bounds_compiled():
+    from numba import njit
+
+    @njit(cache=True)
+    def bounds(q, r, jump_limit):  # pragma: no cover - compiled
+        T = q.shape[0]
+        starts = np.empty(T, np.int64)
+        ends = np.empty(T, np.int64)
+        n = 0
+        start = 0
+        while start < T:
+            rw, rx, ry, rz = q[start, 0], -q[start, 1], -q[start, 2], -q[start, 3]
+            h = -1
+            big = False
+            for i in range(start + 1, T):
+                w, x, y, z = qmul_components(rw, rx, ry, rz, q[i, 0], q[i, 1], q[i, 2], q[i, 3])
+                nv = np.sqrt(x * x + y * y + z * z)
+                if nv > r * abs(w):
+                    h = i - start
+                    big = nv > jump_limit * r * abs(w)
+                    break
+            starts[n] = start
+            if h < 0:
+                ends[n] = T
+                n += 1
+                break
+            ends[n] = start + h if big else start + h + 1
+            n += 1
+            start += h
+        return starts[:n], ends[:n]
+
+    return bounds
+
+
+_CHART_KERNEL = []
+
+
+def _chart_bounds(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
+    """The charts' ``(start, end)``: a numba kernel when numba is used, else :func:`_chart_bounds_numpy`."""
+    from ..util.jit import USE_NUMBA
+
+    if USE_NUMBA and q.shape[0] > 20_000:  # (short series: not worth the compilation)
+        if not _CHART_KERNEL:
+            _CHART_KERNEL.append(_chart_bounds_compiled())
+        a, b = _CHART_KERNEL[0](np.ascontiguousarray(q), float(r), float(jump_limit))
+        return list(zip(a.tolist(), b.tolist()))
+    return _chart_bounds_numpy(q, r, jump_limit)
 
 
 def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
@@ -718,9 +1053,13 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
     TypeError, InvalidInputError, MissingDependencyError
         As for :func:`plot_omega`; ``chart_radius`` not positive.
     """
+    traj, starts = _thin(traj, _MAX_GIBBS_SAMPLES, blocks=True)  # a long run (or a store): evenly strided
     one = select_body(traj, index)
     mpl = import_matplotlib()
-    segs = chart_segments(one.q, chart_radius)
+    segs = []
+    bounds = list(starts) + [len(traj.t)]
+    for a, b in zip(bounds[:-1], bounds[1:]):  # a gap in time (a store read in parts) starts a new chart
+        segs += [(idx + a, n, ref) for idx, n, ref in chart_segments(one.q[a:b], chart_radius)]
     r = float(chart_radius)
     lim = 1.15 * r
     with mpl.rc_context(STYLE):
@@ -731,16 +1070,23 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
         t0, t1 = one.t[0], one.t[-1]
         norm = mpl.colors.Normalize(vmin=t0, vmax=t1)
         kw = {"lw": 1.5, **style}
-        ends = []
-        for idx, n, _ in segs:
+        ends = [n[-1] for _, n, _ in segs]
+        # a long run has thousands of charts: draw at most MAX_CHARTS of them, evenly chosen in time
+        drawn = range(len(segs)) if len(segs) <= MAX_CHARTS else np.unique(
+            np.round(np.linspace(0, len(segs) - 1, MAX_CHARTS)).astype(int))
+        for j in drawn:
+            idx, n, _ = segs[j]
             sl = _stride(len(idx), 4000)
             pts = np.concatenate([n[sl], n[-1:]]) if len(n) > 1 else n
             ax.plot(*pts.T, color=cmap(norm(one.t[idx[0]])), **kw)
-            ends.append(n[-1])
+        if len(segs) > MAX_CHARTS:
+            ax.text2D(0.99, 0.01, f"{len(drawn)} of {len(segs)} charts drawn", transform=ax.transAxes, ha="right",
+                      va="bottom", fontsize=7.5, color="0.4")
         ax.scatter([0], [0], [0], color="k", s=18, depthshade=False, label="chart centre n = 0")
         if len(segs) > 1:
-            E = np.array(ends[:-1])
-            ax.scatter(*E.T, marker="x", color="#d62728", s=30, depthshade=False,
+            # the restarts that end the drawn charts (all of them when every chart is drawn)
+            E = np.array([ends[j] for j in drawn if j < len(segs) - 1])
+            ax.scatter(*E.T, marker="x", color="#d62728", s=30 if len(segs) <= MAX_CHARTS else 12, depthshade=False,
                        label=f"chart restart ({len(segs) - 1}×)")
         for i in range(3):
             e = np.eye(3)[i] * lim
@@ -783,6 +1129,7 @@ def plot_attitude(traj, ax=None, fig=None, *, index=0, **style):
     TypeError, InvalidInputError, MissingDependencyError
         As for :func:`plot_omega`.
     """
+    traj = _thin(traj, _MAX_3D_POINTS)  # a long run (or a store): evenly strided, read piece by piece
     one = select_body(traj, index)
     mpl = import_matplotlib()
     sl = _stride(len(one.t))
@@ -908,6 +1255,7 @@ def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **
     TypeError, InvalidInputError, MissingDependencyError
         As for :func:`plot_omega`; a zero or non-finite ``axis``.
     """
+    traj = _thin(traj, _MAX_APEX_POINTS)  # a long run (or a store): evenly strided, read piece by piece
     one = select_body(traj, index)
     model = _model_of(traj, index)
     if axis is None:

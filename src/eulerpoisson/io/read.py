@@ -1,0 +1,515 @@
+r"""Read every trajectory file eulerpoisson writes: NetCDF-4, NetCDF-3 and Zarr stores.
+
+:func:`open_trajectory` (also :meth:`Trajectory.open
+<eulerpoisson.trajectory.Trajectory.open>`) looks at the file, not at its
+name:
+
+============================ ===============================================
+what                         read by
+============================ ===============================================
+NetCDF-4 (HDF5) file         :meth:`Trajectory.from_netcdf` (h5netcdf)
+NetCDF-3 classic / 64-bit    the same checks, through xarray's ``scipy``
+                             engine
+a Zarr store (a folder)      :class:`LazyTrajectory`: nothing but the
+                             metadata is read when it is opened
+============================ ===============================================
+
+A :class:`LazyTrajectory` is what ``simulate --out run.zarr`` (or
+:func:`~eulerpoisson.io.stream.solve_to_file`) wrote: up to :math:`10^8`
+samples and more, far more than memory. It reads samples on demand — one
+sample, a slice, a whole chunk at a time (:meth:`LazyTrajectory.iter_chunks`)
+— and gives an ordinary in-memory :class:`~eulerpoisson.trajectory.Trajectory`
+for any selection (``lazy[a:b]``, :meth:`LazyTrajectory.load`).
+The plots (:mod:`eulerpoisson.viz.plots`) draw it chunk by chunk, decimated
+to the resolution of the picture, in bounded memory.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import EulerPoissonError, InvalidInputError, require
+
+__all__ = ["open_trajectory", "LazyTrajectory", "StoredArray", "file_format", "NETCDF3_MAGIC", "HDF5_MAGIC"]
+
+#: first bytes of a NetCDF-3 file (classic, 64-bit offset, 64-bit data)
+NETCDF3_MAGIC = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
+#: first bytes of an HDF5 file (NetCDF-4)
+HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
+
+#: stores of at most this many samples are loaded into memory by ``LazyTrajectory.load()`` without asking
+LOAD_LIMIT = 20_000_000
+
+
+def _is_zarr_store(path: Path) -> bool:
+    return path.is_dir() and any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zattrs"))
+
+
+def file_format(path) -> str:
+    """The format of a trajectory file by its content: ``"zarr"``, ``"netcdf4"``, ``"netcdf3"`` or ``"unknown"``."""
+    p = Path(os.fsdecode(path))
+    if p.is_dir():
+        return "zarr" if _is_zarr_store(p) else "unknown"
+    try:
+        with open(p, "rb") as fh:
+            head = fh.read(8)
+    except OSError:
+        return "unknown"
+    if head.startswith(HDF5_MAGIC):
+        return "netcdf4"
+    if head[:4] in NETCDF3_MAGIC:
+        return "netcdf3"
+    return "unknown"
+
+
+def netcdf_engine(path) -> str:
+    """xarray's engine for a NetCDF file: ``"scipy"`` for NetCDF-3, ``"h5netcdf"`` otherwise."""
+    return "scipy" if file_format(path) == "netcdf3" else "h5netcdf"
+
+
+def open_trajectory(path):
+    """Open a trajectory file of any of our formats (see the module notes).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A NetCDF file (version 4 or 3) written by :meth:`Trajectory.to_netcdf`
+        (or converted by another tool), or a Zarr store written by
+        ``simulate --out run.zarr`` / :func:`~eulerpoisson.io.stream.solve_to_file`.
+
+    Returns
+    -------
+    Trajectory or LazyTrajectory
+        An in-memory trajectory for NetCDF, a :class:`LazyTrajectory` for a Zarr store.
+
+    Raises
+    ------
+    TypeError
+        ``path`` is not a file name.
+    FileNotFoundError
+        Nothing at ``path``.
+    EulerPoissonError
+        Not a trajectory file of ours (a folder that is not a Zarr store, an
+        unreadable file, a newer format version).
+    InvalidInputError
+        A malformed file (as :meth:`Trajectory.from_netcdf`).
+    MissingDependencyError
+        xarray/h5netcdf (extra ``io``), scipy, or zarr (extra ``dask``) missing.
+    """
+    from ..trajectory import Trajectory
+
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
+    p = Path(os.fsdecode(path))
+    if not p.exists():
+        raise FileNotFoundError(f"no such file: {path}")
+    if p.is_dir():
+        if not _is_zarr_store(p):
+            raise EulerPoissonError(
+                f"{path} is a folder but not a Zarr store (a trajectory is a NetCDF file or a .zarr store "
+                "written by 'eulerpoisson simulate --out')"
+            )
+        return LazyTrajectory(p)
+    return Trajectory.from_netcdf(path)
+
+
+# ---------------------------------------------------------------------------
+# Zarr stores
+# ---------------------------------------------------------------------------
+def _time_grid(attrs, T: int, first: float, last: float):
+    """The :class:`~eulerpoisson.io.stream.TimeGrid` of a store streamed on ``(t0, t1, n)``, or None.
+
+    Read from the run's record (attribute ``eulerpoisson_run``, when the
+    writer kept one) and checked against the first and last stored times;
+    its values are bit for bit ``numpy.linspace(t0, t1, n)``, as written, so
+    the ``time`` variable need not be read.
+    """
+    from .stream import TimeGrid
+
+    try:
+        grid = json.loads(attrs.get("eulerpoisson_run", "null"))["times"]["grid"]
+        t0, t1, n = float(grid[0]), float(grid[1]), int(grid[2])
+    except (TypeError, ValueError, KeyError, IndexError):
+        return None
+    if n != T:
+        return None
+    g = TimeGrid(t0, t1, n)
+    if float(g[0:1][0]) != first or float(g[n - 1:n][0]) != last:
+        return None
+    return g
+
+
+class StoredArray:
+    """A time-dependent variable of a Zarr store, read on demand: shape ``(*batch, T, ...)``.
+
+    Indexing reads only what is asked for (``a[..., 1000:2000, :]``,
+    ``a[-1]``); ``numpy.asarray(a)`` reads everything.
+    """
+
+    def __init__(self, arr, batch_shape: tuple):
+        self._arr = arr
+        self._bshape = tuple(batch_shape)
+        shp = tuple(arr.shape)
+        self.shape = self._bshape + shp[1:] if self._bshape else shp
+        self.dtype = np.dtype(arr.dtype)
+        self.ndim = len(self.shape)
+        self.chunks = tuple(getattr(arr, "chunks", shp))
+
+    def __len__(self) -> int:
+        return self.shape[0]
+
+    @property
+    def size(self) -> int:
+        return int(np.prod(self.shape))
+
+    def read(self, a: int, b: int, step: int = 1) -> np.ndarray:
+        """Samples ``a:b:step`` along time, shape ``(*batch, n, ...)``."""
+        sl = slice(a, b, step)
+        if self._bshape:
+            x = np.asarray(self._arr[:, sl])
+            return x.reshape(self._bshape + x.shape[1:])
+        return np.asarray(self._arr[sl])
+
+    def __getitem__(self, index):
+        if not self._bshape:
+            return np.asarray(self._arr[index])
+        return np.asarray(self)[index]  # batches are small stores in practice
+
+    def __array__(self, dtype=None, copy=None):
+        x = np.asarray(self._arr[...])
+        if self._bshape:
+            x = x.reshape(self.shape)
+        return x if dtype is None else x.astype(dtype)
+
+    def __repr__(self) -> str:
+        return f"StoredArray(shape={self.shape}, dtype={self.dtype})"
+
+
+def _zarr_group(path: Path):
+    import warnings
+
+    zarr = require("zarr", "dask")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            return zarr.open_group(str(path), mode="r")
+        except Exception as exc:  # noqa: BLE001 - any failure: not a readable store
+            raise EulerPoissonError(f"{path} is not a readable Zarr store: {exc}") from exc
+
+
+class LazyTrajectory:
+    r"""A trajectory in a Zarr store (written by ``simulate --out run.zarr``), read on demand.
+
+    Opening reads the metadata (attributes, the body, the torques) and the
+    first and last samples, and checks them as :meth:`Trajectory.from_netcdf`
+    does; the other samples are read when asked for (an unwritten sample of
+    an unfinished run's partial store is an error naming it). ``len(lazy)`` is the number of samples; ``lazy[i]``,
+    ``lazy[a:b]`` (a slice with any step) and ``lazy[[i, j]]`` are in-memory
+    :class:`~eulerpoisson.trajectory.Trajectory` objects; :meth:`head` and
+    :meth:`tail` the first and last samples; :meth:`iter_chunks` walks the
+    store one Zarr chunk at a time; :meth:`load` reads it all.
+
+    Attributes
+    ----------
+    path : pathlib.Path
+    t, quaternion, omega : StoredArray
+        Read on demand (``numpy.asarray`` reads all of it).
+    body, model, method, options, stats, batch_shape
+        As for :class:`~eulerpoisson.trajectory.Trajectory`.
+    chunk : int
+        Samples per Zarr chunk along time.
+    variables : tuple of str
+        The time-dependent variables stored (``quaternion``, ``omega`` and any
+        of ``M``, ``m``, ``energy``, ``gibbs``).
+
+    Raises
+    ------
+    EulerPoissonError
+        Not an eulerpoisson store, or a newer format version.
+    InvalidInputError
+        Malformed attributes or variables (shapes, the body, the torques), or
+        first or last attitudes that are not unit quaternions.
+    """
+
+    lazy = True
+
+    def __init__(self, path):
+        from ..model.body import RigidBody
+        from ..model.equations import Model
+        from ..trajectory import FORMAT_VERSION, _format_version, _json_attr, _read_torques
+
+        self.path = Path(path)
+        g = _zarr_group(self.path)
+        self._group = g
+        attrs = dict(g.attrs)
+        names = set(g.array_keys()) if hasattr(g, "array_keys") else set(g.keys())
+        ver = attrs.get("eulerpoisson_format_version")
+        if ver is None or "quaternion" not in names or "omega" not in names:
+            raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory store")
+        ver = _format_version(path, ver)
+        if ver > FORMAT_VERSION:
+            raise EulerPoissonError(
+                f"{path} has format version {ver}, newer than this eulerpoisson ({FORMAT_VERSION}); upgrade the package"
+            )
+        missing = [v for v in ("time", "inertia") if v not in names]
+        if missing:
+            raise InvalidInputError(f"{path}: malformed eulerpoisson trajectory store, variable(s) {missing} missing")
+
+        class _Attrs:  # what the NetCDF helpers expect: ds.attrs
+            pass
+
+        ds = _Attrs()
+        ds.attrs = attrs
+        bshape = _json_attr(path, ds, "batch_shape", "[]", list)
+        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
+            raise InvalidInputError(f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}")
+        self.batch_shape = tuple(bshape)
+        self.options = _json_attr(path, ds, "method_options", "{}", dict)
+        self.stats = _json_attr(path, ds, "stats", "{}", dict)
+        self.method = str(attrs.get("method", ""))
+        tarr = g["time"]
+        if len(tarr.shape) != 1:
+            raise InvalidInputError(f"{path}: variable time must be 1-D, got shape {tuple(tarr.shape)}")
+        T = int(tarr.shape[0])
+        lead = (int(np.prod(self.batch_shape)),) if self.batch_shape else ()
+        self.variables = tuple(v for v in ("quaternion", "omega", "M", "m", "energy", "gibbs") if v in names)
+        for nm in self.variables:
+            tail = {"quaternion": (4,), "energy": ()}.get(nm, (3,))
+            if tuple(g[nm].shape) != lead + (T,) + tail:
+                raise InvalidInputError(
+                    f"{path}: variable {nm} has shape {tuple(g[nm].shape)}, expected {lead + (T,) + tail} "
+                    f"(batch_shape {list(self.batch_shape)}, {T} times)"
+                )
+        inertia = np.asarray(g["inertia"][...], dtype=float)
+        if inertia.shape != lead + (3, 3):
+            raise InvalidInputError(f"{path}: variable inertia has shape {inertia.shape}, expected {lead + (3, 3)}")
+        if self.batch_shape:
+            inertia = inertia.reshape(self.batch_shape + (3, 3))
+        name = attrs.get("body_name") or None
+        try:
+            if "particle_masses" in names:
+                body = RigidBody.from_particles(
+                    np.asarray(g["particle_masses"][...]),
+                    np.asarray(g["particle_positions"][...]) + np.asarray(g["center_of_mass"][...]),
+                    name=None if name is None else str(name),
+                )
+            else:
+                body = RigidBody(inertia, name=None if name is None else str(name), allow_unphysical=True)
+            self.model = Model(body, _read_torques(path, ds))
+        except (InvalidInputError, TypeError) as exc:
+            raise type(exc)(f"{path}: {exc}") from exc
+        self.body = body
+        self.T = T
+        self.chunk = int(tarr.chunks[0]) if T else 1
+        self.t = StoredArray(tarr, ())
+        self.quaternion = StoredArray(g["quaternion"], self.batch_shape)
+        self.omega = StoredArray(g["omega"], self.batch_shape)
+        self.attrs = attrs
+        self._grid = None
+        if T:
+            first, last = self.head(), self.tail()  # checks the first and last attitudes (unit quaternions)
+            self._grid = _time_grid(attrs, T, float(first.t[0]), float(last.t[-1]))
+
+    # ------------------------------------------------------------------
+    def __len__(self) -> int:
+        return self.T
+
+    def stored(self, name: str) -> StoredArray:
+        """A stored time-dependent variable (``"quaternion"``, ``"omega"``, ``"M"``, ``"m"``, ``"energy"``, ``"gibbs"``)."""
+        if name not in self.variables:
+            raise KeyError(f"{self.path} has no variable {name!r} (it has {', '.join(self.variables)})")
+        return StoredArray(self._group[name], self.batch_shape)
+
+    def _check_unit(self, q: np.ndarray, where: str) -> None:
+        from ..attitude.core import UNIT_QUATERNION_TOLERANCE
+
+        with np.errstate(invalid="ignore", over="ignore"):
+            w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+            norms = np.sqrt(w * w + x * x + y * y + z * z)
+        norms = norms[np.isfinite(norms)]
+        if norms.size and not np.all(np.abs(norms - 1.0) <= UNIT_QUATERNION_TOLERANCE):
+            worst = float(norms[np.argmax(np.abs(norms - 1.0))])
+            raise InvalidInputError(
+                f"{self.path}: the quaternion variable is not made of unit quaternions ({where}: a norm of "
+                f"{worst:.9g}; we write norm 1 within {UNIT_QUATERNION_TOLERANCE:g}): the store was modified or is not ours"
+            )
+
+    def read(self, a: int = 0, b: int | None = None, step: int = 1):
+        """The samples ``a:b:step`` as an in-memory :class:`~eulerpoisson.trajectory.Trajectory`.
+
+        Raises
+        ------
+        EulerPoissonError
+            Samples not written yet (NaN: an unfinished run's partial store).
+        """
+        from ..trajectory import Trajectory
+
+        a, b, step = slice(a, b, step).indices(self.T)
+        t = self.t.read(a, b, step)
+        q = self.quaternion.read(a, b, step)
+        w = self.omega.read(a, b, step)
+        self._check_unit(q, f"samples {a}:{b}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
+            raise EulerPoissonError(
+                f"{self.path}: samples {a}:{b} are not all written (NaN): an unfinished run? "
+                "resume it with the same 'simulate' command"
+            )
+        return Trajectory(t, q, w, self.body, self.method, self.options, self.stats, torque=list(self.model.torques))
+
+    def read_arrays(self, names, a: int = 0, b: int | None = None, step: int = 1) -> dict:
+        """The raw arrays ``names`` (``"time"`` and stored variables) at samples ``a:b:step``, without a Trajectory.
+
+        The cheapest way through a long store: only the named variables are
+        read (a plot of Ω reads ``time`` and ``omega``, nothing else).
+        Quaternions read are checked to be unit; any NaN (an unwritten sample
+        of a partial store) is an error.
+        """
+        a, b, step = slice(a, b, step).indices(self.T)
+        out = {}
+        for nm in names:
+            if nm == "time" and self._grid is not None:  # equally spaced times: computed, bit for bit those stored
+                out[nm] = self._grid[a:b:step]
+                continue
+            arr = self.t if nm == "time" else self.stored(nm)
+            x = arr.read(a, b, step)
+            if nm == "quaternion":
+                self._check_unit(x, f"samples {a}:{b}")
+            if nm != "gibbs" and not np.all(np.isfinite(x)):
+                raise EulerPoissonError(
+                    f"{self.path}: samples {a}:{b} of {nm} are not all written (NaN): an unfinished run? "
+                    "resume it with the same 'simulate' command"
+                )
+            out[nm] = x
+        return out
+
+    def iter_arrays(self, names, size: int | None = None, ranges=None):
+        """:meth:`read_arrays` piece by piece (``size`` samples, whole Zarr chunks; or the given ``(a, b)`` ranges).
+
+        The next piece is read in a background thread while the caller works on the current one.
+        """
+        from concurrent.futures import ThreadPoolExecutor
+
+        ranges = list(self.chunk_bounds(size) if ranges is None else ranges)
+        if not ranges:
+            return
+        with ThreadPoolExecutor(1) as ex:
+            nxt = ex.submit(self.read_arrays, names, *ranges[0])
+            for k in range(len(ranges)):
+                cur = nxt.result()
+                if k + 1 < len(ranges):
+                    nxt = ex.submit(self.read_arrays, names, *ranges[k + 1])
+                yield cur
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return self.read(index.start or 0, index.stop, index.step or 1) if (index.step or 1) > 0 else \
+                self.load()[index]
+        if isinstance(index, (int, np.integer)) and not isinstance(index, (bool, np.bool_)):
+            i = int(index) + (self.T if index < 0 else 0)
+            if not 0 <= i < self.T:
+                raise IndexError(f"sample {index} out of range for {self.T} samples")
+            return self.read(i, i + 1)
+        if isinstance(index, (tuple, float, np.floating, str, bool, np.bool_)):
+            raise TypeError(f"a trajectory is indexed by sample (int, slice or integer array), got {index!r}")
+        idx = np.atleast_1d(np.asarray(index))
+        if idx.dtype == bool:
+            if idx.shape != (self.T,):
+                raise IndexError(f"boolean index of shape {idx.shape} for {self.T} samples")
+            idx = np.flatnonzero(idx)
+        if idx.size and not np.issubdtype(idx.dtype, np.integer):
+            raise TypeError(f"a trajectory is indexed by sample (int, slice or integer array), got {index!r}")
+        idx = idx.astype(np.int64)
+        if np.any((idx < -self.T) | (idx >= self.T)):
+            raise IndexError(f"sample index out of range for {self.T} samples")
+        idx = np.where(idx < 0, idx + self.T, idx)
+        if idx.size == 0:
+            return self.read(0, 0)
+        return self.gather(idx)
+
+    def gather(self, idx):
+        """The samples ``idx`` (any integers in range, any order) as a Trajectory; each Zarr chunk is read once."""
+        from ..trajectory import Trajectory
+
+        idx = np.asarray(idx, dtype=np.int64)
+        order = np.argsort(idx, kind="stable")
+        srt = idx[order]
+        blocks = srt // self.chunk
+        cut = np.flatnonzero(np.diff(blocks)) + 1
+        parts = []
+        for grp in np.split(srt, cut):
+            lo, hi = int(grp[0]), int(grp[-1]) + 1
+            raw = self.read_arrays(("time", "quaternion", "omega"), lo, hi)
+            k = grp - lo
+            parts.append((raw["time"][k], raw["quaternion"][..., k, :], raw["omega"][..., k, :]))
+        t = np.concatenate([p[0] for p in parts])
+        q = np.concatenate([p[1] for p in parts], axis=-2)
+        w = np.concatenate([p[2] for p in parts], axis=-2)
+        inv = np.empty_like(order)
+        inv[order] = np.arange(order.size)
+        return Trajectory(t[inv], q[..., inv, :], w[..., inv, :], self.body, self.method, self.options, self.stats,
+                          torque=list(self.model.torques))
+
+    def head(self, n: int = 1):
+        """The first ``n`` samples (a Trajectory)."""
+        return self.read(0, min(n, self.T))
+
+    def tail(self, n: int = 1):
+        """The last ``n`` samples (a Trajectory)."""
+        return self.read(max(0, self.T - n), self.T)
+
+    def chunk_bounds(self, size: int | None = None):
+        """``(a, b)`` sample ranges of ``size`` (default: the store's chunk) covering the store."""
+        size = int(size or self.chunk)
+        size = max(1, -(-size // self.chunk) * self.chunk)  # whole Zarr chunks
+        return [(a, min(self.T, a + size)) for a in range(0, self.T, size)]
+
+    def iter_chunks(self, size: int | None = None):
+        """In-memory trajectories of consecutive pieces of the store, ``size`` samples each (whole Zarr chunks)."""
+        for a, b in self.chunk_bounds(size):
+            yield self.read(a, b)
+
+    def load(self, *, limit: int | None = LOAD_LIMIT):
+        """The whole store as an in-memory Trajectory.
+
+        Raises
+        ------
+        EulerPoissonError
+            More than ``limit`` samples (pass ``limit=None`` to read them anyway).
+        """
+        if limit is not None and self.T * max(1, int(np.prod(self.batch_shape))) > limit:
+            raise EulerPoissonError(
+                f"{self.path} has {self.T} samples, more than {limit} to load into memory "
+                "(about 100 bytes each); read a part (lazy[a:b], iter_chunks()) or pass limit=None"
+            )
+        return self.read(0, self.T)
+
+    # ------------------------------------------------------------------
+    def drift_endpoints(self) -> dict:
+        """Relative change of every integral from the first to the last sample (reads two samples).
+
+        The drift of :meth:`Trajectory.drift` is a maximum over all samples;
+        for a long store this is its value at the end, which costs nothing.
+        """
+        from ..trajectory import Trajectory
+
+        if self.T == 0:
+            raise InvalidInputError("drift of a store with no output times")
+        h, tl = self.head(), self.tail()
+        both = Trajectory(np.concatenate([h.t, tl.t]), np.concatenate([h.quaternion, tl.quaternion], axis=-2),
+                          np.concatenate([h.omega, tl.omega], axis=-2), self.body, self.method,
+                          torque=list(self.model.torques))
+        return both.drift()
+
+    def plot(self, kind: str = "omega", **kwargs):
+        """A picture of the stored trajectory, drawn chunk by chunk: :func:`eulerpoisson.viz.plots.plot`."""
+        from ..viz import plots
+
+        return plots.plot(self, kind, **kwargs)
+
+    def __repr__(self) -> str:
+        b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
+        return f"LazyTrajectory({str(self.path)!r}, method={self.method!r}, T={self.T}{b})"

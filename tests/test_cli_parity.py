@@ -127,3 +127,16 @@ def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
     assert tr.stats["chunks"] == 5
     ref = ep.solve([1, 2, 3], t, omega0=[1, 0.1, 0.5])
     assert np.max(np.abs(tr.quaternion - ref.quaternion)) < 1e-8
+
+
+def test_a_run_written_nowhere_keeps_its_ends_and_the_same_drift():
+    from eulerpoisson.cli import commands
+
+    t = np.linspace(0.0, 50.0, 12001)
+    model = ep.Model([1, 2, 3])
+    full = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
+    ends, drift = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False,
+                                            keep=False)
+    assert ends.t.tolist() == [0.0, 50.0]
+    np.testing.assert_array_equal(ends.quaternion[-1], full.quaternion[-1])
+    assert drift == full.drift()

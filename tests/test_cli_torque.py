@@ -498,6 +498,9 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
     plot = _examples(capsys, "plot")
     assert any("--com" in c for c in sim) and any("--gravity-gradient" in c for c in sim)
     assert any("apex" in c for c in sim + plot)
+    # the store the plot examples read (the README's 1e8-sample long.zarr, smaller)
+    assert run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "100",
+               "--samples", "20000", "--out", "long.zarr", "--quiet")[0] == 0
     ran = 0
     for argv in sim + plot:
         code, out, err = run(capsys, *argv)

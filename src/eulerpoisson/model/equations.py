@@ -41,6 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..attitude.core import matrix_from_unit_quaternion
 from ..errors import InvalidInputError
 from ..numerics.quaternion import qmul_components
 from .body import RigidBody
@@ -402,10 +403,11 @@ class Model:
             return a.reshape(a.shape[: a.ndim - tail] + (1,) + a.shape[a.ndim - tail:])
 
         inertia = per_body(self.body.inertia, 2)
-        R = _matrix(q)
-        M = _mv(inertia, omega)
-        m = _mv(R, M)
-        kinetic = 0.5 * _dot(omega, M)
+        # the same expressions as Trajectory.M, .m and .energy (so that the drifts agree to the last bit)
+        R = matrix_from_unit_quaternion(q)
+        M = np.einsum("...ij,...j->...i", inertia, omega)
+        m = np.einsum("...ij,...j->...i", R, M)
+        kinetic = 0.5 * np.sum(omega * M, -1)
         out: dict[str, np.ndarray] = {}
         if self.is_free:
             out["energy"] = kinetic

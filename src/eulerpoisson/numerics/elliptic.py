@@ -224,7 +224,7 @@ def _ellipk_dd(m1):
 # ---------------------------------------------------------------------------
 # Jacobi elliptic functions
 # ---------------------------------------------------------------------------
-class _JacobiParams:
+class JacobiParams:
     """Precomputed, parameter-only data for the Jacobi kernels (plain arrays).
 
     Attributes (all broadcastable to the parameter shape)
@@ -245,7 +245,7 @@ class _JacobiParams:
 
     def take(self, index):
         """Gather along the (flattened, 1-d) parameter axis."""
-        new = _JacobiParams()
+        new = JacobiParams()
         for name in ("m", "m1", "kp", "sep", "imag", "kh", "kl", "ph", "pcorr"):
             setattr(new, name, getattr(self, name)[index])
         new.sqm = self.sqm[:, index]
@@ -253,10 +253,10 @@ class _JacobiParams:
         return new
 
 
-def _jacobi_params(m, m1):
+def jacobi_params(m, m1):
     m = np.asarray(m, dtype=np.float64)
     m1 = np.asarray(m1, dtype=np.float64)
-    P = _JacobiParams()
+    P = JacobiParams()
     P.m, P.m1 = m, m1
     P.kp = np.sqrt(m1)
     P.sep = m1 == 0.0
@@ -438,7 +438,7 @@ def _quadrant(n, s, c, d, kp):
     return sn, cn, dn
 
 
-def _sncndn_dd(uh, ul, P):
+def sncndn_dd(uh, ul, P):
     """Internal entry point: ``u`` double-double, params precomputed.
 
     Returns ``(sn, cn, dn, n, r, s, c, d)``: the function values at ``u``, the
@@ -495,8 +495,8 @@ def jacobi_sncndn(u, m=None, m1=None):
     """
     u = _as_float_array(u, "u")
     m, m1 = _parameters(m, m1)
-    P = _jacobi_params(m, m1)
-    sn, cn, dn, *_ = _sncndn_dd(u, np.zeros_like(u), P)
+    P = jacobi_params(m, m1)
+    sn, cn, dn, *_ = sncndn_dd(u, np.zeros_like(u), P)
     shape = np.broadcast_shapes(u.shape, m.shape)
     return tuple(_out(np.broadcast_to(x, shape).copy()) for x in (sn, cn, dn))
 
@@ -532,8 +532,8 @@ def jacobi_am(u, m=None, m1=None):
     """
     u = _as_float_array(u, "u")
     m, m1 = _parameters(m, m1)
-    P = _jacobi_params(m, m1)
-    _, _, _, n, r, s, c, _ = _sncndn_dd(u, np.zeros_like(u), P)
+    P = jacobi_params(m, m1)
+    _, _, _, n, r, s, c, _ = sncndn_dd(u, np.zeros_like(u), P)
     am = _am_from_reduced(n, r, s, c, P)
     shape = np.broadcast_shapes(u.shape, m.shape)
     return _out(np.broadcast_to(am, shape).copy())
@@ -639,7 +639,7 @@ def _rf_step(st):
     return [0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)]
 
 
-def _rf(x, y, z):
+def rf_core(x, y, z):
     """R_F for non-negative arrays with at most one zero (no checks)."""
     shape, (x, y, z) = _flat(x, y, z)
     a0 = (x + y + z) / 3.0
@@ -762,7 +762,7 @@ def _rj_step(st):
     ]
 
 
-def _rj(x, y, z, p):
+def rj_core(x, y, z, p):
     """R_J for x, y, z >= 0 (at most one zero), p > 0 (no checks)."""
     shape, (x, y, z, p) = _flat(x, y, z, p)
     a0 = (x + y + z + 2.0 * p) / 5.0
@@ -850,7 +850,7 @@ def elliprf(x, y, z):
     zeros = (x == 0.0).astype(int) + (y == 0.0) + (z == 0.0)
     if np.any(zeros >= 2):
         raise InvalidInputError("elliprf: at most one of x, y, z may be zero (R_F diverges)")
-    return _out(_rf(x, y, z))
+    return _out(rf_core(x, y, z))
 
 
 def elliprd(x, y, z):
@@ -924,7 +924,7 @@ def elliprj(x, y, z, p):
     zeros = (x == 0.0).astype(int) + (y == 0.0) + (z == 0.0)
     if np.any(zeros >= 2):
         raise InvalidInputError("elliprj: at most one of x, y, z may be zero (R_J diverges)")
-    return _out(_rj(x, y, z, p))
+    return _out(rj_core(x, y, z, p))
 
 
 def elliprc(x, y):
@@ -1006,7 +1006,7 @@ def ellipf(phi, m=None, m1=None):
     j, s, c = _reduce_pi(phi)
     s2 = s * s
     delta2 = np.where(m <= 0.5, 1.0 - m * s2, c * c + m1 * s2)
-    f = s * _rf(c * c, delta2, 1.0)
+    f = s * rf_core(c * c, delta2, 1.0)
     with np.errstate(invalid="ignore"):
         out = np.where(j == 0.0, f, (2.0 * j * kh + f) + 2.0 * j * kl)
     return _out(out)
@@ -1044,7 +1044,7 @@ def ellippi_complete(n, m=None, m1=None):
     m, m1 = _parameters(m, m1)
     kh, _, _ = _ellipk_dd(m1)
     sep = m1 == 0.0
-    rj = _rj(0.0, np.where(sep, 1.0, m1), 1.0, 1.0 - n)
+    rj = rj_core(0.0, np.where(sep, 1.0, m1), 1.0, 1.0 - n)
     out = np.where(sep, np.inf, kh + n / 3.0 * rj)
     return _out(out)
 
@@ -1098,8 +1098,8 @@ def ellippi(n, phi, m=None, m1=None):
     c2 = c * c
     delta2 = np.where(m <= 0.5, 1.0 - m * s2, c2 + m1 * s2)
     p = np.where(n <= 0.0, 1.0 - n * s2, (1.0 - n) + n * c2)
-    part = s * _rf(c2, delta2, 1.0) + n / 3.0 * (s * s2) * _rj(c2, delta2, 1.0, p)
-    full = kh + n / 3.0 * _rj(0.0, np.where(sep, 1.0, m1), 1.0, 1.0 - n)
+    part = s * rf_core(c2, delta2, 1.0) + n / 3.0 * (s * s2) * rj_core(c2, delta2, 1.0, p)
+    full = kh + n / 3.0 * rj_core(0.0, np.where(sep, 1.0, m1), 1.0, 1.0 - n)
     with np.errstate(invalid="ignore"):
         out = np.where(j == 0.0, part, 2.0 * j * full + part)
     return _out(out)

@@ -337,7 +337,7 @@ def _rj_finish(a0, x0, y0, z0, a, fac, acc):
 def _rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
     """Up to three independent ``R_J`` values (lanes ``on_*``), duplications interleaved.
 
-    Every lane performs exactly the operations of ``elliptic._rj`` and stops
+    Every lane performs exactly the operations of ``elliptic.rj_core`` and stops
     by its own criterion.  Lanes that are off return 0.
     """
     a0a, dla, sca, qa = _rj_init(xa, ya, za, pa)
@@ -384,7 +384,7 @@ def _params(m, m1, rx, ry, rz, do_rf, cst):
     own stopping rule and iteration limit, so that their latency chains
     overlap; each performs exactly the operations of its stand-alone version:
     the AGM for ``K`` in double-double (``elliptic._ellipk_dd``), the
-    descending Landen chain (``elliptic._jacobi_params``) and the duplication
+    descending Landen chain (``elliptic.jacobi_params``) and the duplication
     of ``R_F`` (if ``do_rf``).  Returns the ``R_F`` value (0 if not
     ``do_rf``).
     """
@@ -485,7 +485,7 @@ def _params(m, m1, rx, ry, rz, do_rf, cst):
 
 # =============================================================================
 # Jacobi elliptic functions of double-double arguments, up to three at once
-# (``elliptic._sncndn_dd``: reduction modulo K, Landen ascent, quarter map)
+# (``elliptic.sncndn_dd``: reduction modulo K, Landen ascent, quarter map)
 # =============================================================================
 def _sech(x):
     e = math.exp(-abs(x))
@@ -577,7 +577,7 @@ def _sncndn3(k, u1h, u1l, u2h, u2l, u3h, u3l, cst):
     Returns ``(sn, cn, dn, n, r, s, c, d)`` of each of the three lanes (a
     24-tuple; lanes beyond ``k`` are zeros): the values at ``u``, the
     quarter-period index ``n``, the reduced argument ``r`` and the values at
-    ``r``, exactly as ``elliptic._sncndn_dd``.
+    ``r``, exactly as ``elliptic.sncndn_dd``.
     """
     sep = cst[_C_SEP] != 0.0
     kh = cst[_C_KH]

@@ -147,6 +147,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...numerics import elliptic as _el
+from ...numerics.doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, two_prod, two_sum
 from ...numerics.quaternion import qmul_components
 from ...errors import InvalidInertiaError, InvalidInputError
 
@@ -319,15 +320,15 @@ class _Body:
 
 def _dd_square_times(x, dh, dl, y):
     """``x^2 * (dh + dl) * y`` as double-double."""
-    sh, sl = _el._two_prod(x, x)
-    ph, pl = _el._dd_mul(sh, sl, dh, dl)
-    return _el._dd_mul_d(ph, pl, y)
+    sh, sl = two_prod(x, x)
+    ph, pl = dd_mul(sh, sl, dh, dl)
+    return dd_mul_d(ph, pl, y)
 
 
 def _jc(nu_om, m1, sep):
     """Complete ``J_c = R_J(0, m1, 1, 1 - nu) / 3`` (0 on the separatrix)."""
     with np.errstate(all="ignore"):
-        jc = _el._rj(0.0, np.where(sep, 1.0, m1), 1.0, nu_om) / 3.0
+        jc = _el.rj_core(0.0, np.where(sep, 1.0, m1), 1.0, nu_om) / 3.0
     return np.where(sep, 0.0, jc)
 
 
@@ -346,11 +347,11 @@ def _constants(Is, Ms):
     a1 = M2 * M2 * d21 / I2 + M3 * M3 * d31 / I3
     a3 = M1 * M1 * d31 / I1 + M2 * M2 * d32 / I2
     # D = M^2 - 2 E I2 = (M3^2 (I3-I2) I1 - M1^2 (I2-I1) I3) / (I1 I3), double-double
-    d32h, d32l = _el._two_sum(I3, -I2)
-    d21h, d21l = _el._two_sum(I2, -I1)
+    d32h, d32l = two_sum(I3, -I2)
+    d21h, d21l = two_sum(I2, -I1)
     t3h, t3l = _dd_square_times(M3, d32h, d32l, I1)
     t1h, t1l = _dd_square_times(M1, d21h, d21l, I3)
-    dh, _ = _el._dd_add(t3h, t3l, -t1h, -t1l)
+    dh, _ = dd_add(t3h, t3l, -t1h, -t1l)
     D = dh / (I1 * I3)
     eq = (
         (msq == 0.0)
@@ -422,17 +423,17 @@ def _constants(Is, Ms):
         h = np.hypot(x, y)
         c0 = x / h
         s0 = y / h
-    P = _el._jacobi_params(m, m1)
+    P = _el.jacobi_params(m, m1)
     kh, kl = P.kh, P.kl
     s2 = s0 * s0
     delta2 = np.where(m <= 0.5, 1.0 - m * s2, c0 * c0 + m1 * s2)
     with np.errstate(divide="ignore", invalid="ignore"):
-        F0 = s0 * _el._rf(c0 * c0, np.where(sep, 1.0, delta2), 1.0)
+        F0 = s0 * _el.rf_core(c0 * c0, np.where(sep, 1.0, delta2), 1.0)
         tsep = np.arcsinh(s0 / c0)
     sg = np.where(s0 < 0.0, -1.0, 1.0)
-    th, tl = _el._two_sum(sg * 2.0 * kh, -F0)
+    th, tl = two_sum(sg * 2.0 * kh, -F0)
     tl = tl + sg * 2.0 * kl
-    th, tl = _el._quick_two_sum(th, tl)
+    th, tl = quick_two_sum(th, tl)
     neg = c0 < 0.0
     t0h = np.where(sep, tsep, np.where(neg, th, F0))
     t0l = np.where(sep | ~neg, 0.0, tl)
@@ -451,7 +452,7 @@ def _constants(Is, Ms):
     B.sep, B.caseB, B.P = sep, caseB, P
     B.kfull = np.where(sep, np.inf, kh)
     # values at t = 0
-    sn, _, _, n, r, s, c, d = _el._sncndn_dd(t0h, t0l, P)
+    sn, _, _, n, r, s, c, d = _el.sncndn_dd(t0h, t0l, P)
     B.sn0 = sn
     B.theta0 = _theta(B, P, n, s, c)
     B.Jfar0 = _jfar(B, P, n, r, s, c, d)
@@ -476,7 +477,7 @@ def _jtot(nu, omnu, jc, n, r, s, c, d, kp, sep):
     C2 = C * C
     p = np.where(nu <= 0.0, 1.0 - nu * S2, omnu + nu * C2)
     ok = ~sep & (S2 > 0.0)
-    rj = _el._rj(np.where(ok, C2, 1.0), np.where(ok, Dd * Dd, 1.0), 1.0, np.where(ok, p, 1.0))
+    rj = _el.rj_core(np.where(ok, C2, 1.0), np.where(ok, Dd * Dd, 1.0), 1.0, np.where(ok, p, 1.0))
     jq = np.where(ok, S * S2 * rj / 3.0, 0.0)
     jper = np.where(odd, np.sign(r) * (jc - jq), np.where(r < 0.0, -jq, jq))
     return np.where(sep, 0.0, n * jc + jper)
@@ -519,7 +520,7 @@ def _near(B, P, dh, dl, sn_tau):
     integral of the third kind, Whittaker & Watson 22.74, specialized to real
     characteristic).  Every term is O(delta): no offset from ``tau0``.
     """
-    snd, cnd, dnd, n, r, s, c, d = _el._sncndn_dd(dh, dl, P)
+    snd, cnd, dnd, n, r, s, c, d = _el.sncndn_dd(dh, dl, P)
     N = B.Nadd
     Pp = sn_tau * B.sn0
     X = 1.0 + N * snd * snd + N * Pp * cnd * dnd
@@ -570,7 +571,7 @@ def _subset(B, mask):
             continue
         setattr(sub, name, np.broadcast_to(getattr(B, name), shape)[mask])
     P = B.P
-    P2 = _el._JacobiParams()
+    P2 = _el.JacobiParams()
     for name in ("m", "m1", "kp", "sep", "imag", "kh", "kl", "ph", "pcorr"):
         setattr(P2, name, np.broadcast_to(getattr(P, name), shape)[mask])
     L = P.sqm.shape[0]
@@ -608,10 +609,10 @@ def _increment(B, dh, dl, sn, n, r, s, c, d):
 def _generic_block(B, ts):
     """M (sorted frame) and q for bodies ``B`` (arrays (nb, 1)) at scaled times ``ts``."""
     P = B.P
-    dh, dl = _el._two_prod(B.lam, ts)
-    th, tl = _el._dd_add(dh, dl, B.t0h, B.t0l)
+    dh, dl = two_prod(B.lam, ts)
+    th, tl = dd_add(dh, dl, B.t0h, B.t0l)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        sn, cn, dn, n, r, s, c, d = _el._sncndn_dd(th, tl, P)
+        sn, cn, dn, n, r, s, c, d = _el.sncndn_dd(th, tl, P)
         shape = sn.shape
         dh = np.broadcast_to(dh, shape)
         dl = np.broadcast_to(dl, shape)
@@ -650,7 +651,7 @@ def _take_body(B, idx):
         val = getattr(B, name)
         setattr(new, name, val[idx][:, None])
     P = B.P.take(idx)
-    P2 = _el._JacobiParams()
+    P2 = _el.JacobiParams()
     for name in ("m", "m1", "kp", "sep", "imag", "kh", "kl", "ph", "pcorr"):
         setattr(P2, name, getattr(P, name)[:, None])
     P2.sqm = P.sqm[:, :, None]

@@ -140,3 +140,10 @@ def test_a_run_written_nowhere_keeps_its_ends_and_the_same_drift():
     assert ends.t.tolist() == [0.0, 50.0]
     np.testing.assert_array_equal(ends.quaternion[-1], full.quaternion[-1])
     assert drift == full.drift()
+
+
+def test_atlas_of_a_trajectory_says_it_needs_a_sweep_store(capsys, tmp_path):
+    nc = tmp_path / "run.nc"
+    ep.solve([1, 2, 3], [0.0, 1.0], omega0=[1, 0, 0]).to_netcdf(nc)
+    code, out, err = run(capsys, "plot", str(nc), "--kind", "atlas", "--out", str(tmp_path / "a.png"))
+    assert code == 2 and "--kind atlas draws a sweep store" in err

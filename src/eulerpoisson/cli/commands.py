@@ -760,8 +760,13 @@ def cmd_plot(args) -> int:
     if args.kind == "atlas":
         from ..sweep.runner import load_sweep, plot_atlas
 
+        from ..io.outputs import file_kind
+
         if not os.path.exists(args.file):
             raise UsageError(f"{args.file}: no such sweep store (make one with 'eulerpoisson sweep sweep.toml')")
+        if file_kind(args.file) != "sweep-store":
+            raise UsageError(f"{args.file}: --kind atlas draws a sweep store (made by 'eulerpoisson sweep'), and this "
+                             f"is not one; a trajectory has the kinds omega, invariants, polhode, gibbs, attitude, apex")
         plot_atlas(load_sweep(args.file), out)
     else:
         from ..viz import plots

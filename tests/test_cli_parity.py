@@ -147,3 +147,30 @@ def test_atlas_of_a_trajectory_says_it_needs_a_sweep_store(capsys, tmp_path):
     ep.solve([1, 2, 3], [0.0, 1.0], omega0=[1, 0, 0]).to_netcdf(nc)
     code, out, err = run(capsys, "plot", str(nc), "--kind", "atlas", "--out", str(tmp_path / "a.png"))
     assert code == 2 and "--kind atlas draws a sweep store" in err
+
+
+def test_a_file_whose_times_are_all_equal_is_refused(tmp_path):
+    xr = pytest.importorskip("xarray")
+    ep.solve([1, 2, 3], [0.0, 1.0, 2.0], omega0=[1, 0.1, 0.5]).to_netcdf(tmp_path / "a.nc")
+    ds = xr.open_dataset(tmp_path / "a.nc", engine="h5netcdf").load()
+    ds = ds.assign_coords(time=np.zeros(3))
+    ds.to_netcdf(tmp_path / "b.nc", engine="h5netcdf")
+    with pytest.raises(ep.InvalidInputError, match="b.nc: the time variable holds the same value 0.0 for all 3"):
+        ep.Trajectory.from_netcdf(tmp_path / "b.nc")
+
+
+def test_the_help_examples_of_info_and_animate_run(capsys, tmp_path, monkeypatch):
+    import shlex
+
+    monkeypatch.chdir(tmp_path)
+    ep.solve([1, 2, 3], np.linspace(0, 10, 101), omega0=[1, 0.1, 0.5]).to_netcdf(tmp_path / "run.nc")
+    assert run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10", "--samples",
+               "20000", "--out", "long.zarr", "--quiet")[0] == 0
+    for command in ("info", "animate"):
+        code, out, _ = run(capsys, command, "--help")
+        assert code == 0
+        text = out.split("examples:", 1)[1].split("\n\n", 1)[0]
+        lines = [ln.split("#", 1)[0].strip() for ln in text.splitlines()]
+        for line in (ln for ln in lines if ln.startswith("eulerpoisson ")):
+            code, out, err = run(capsys, *shlex.split(line)[1:])
+            assert code == 0, (line, err)

@@ -483,6 +483,9 @@ class Trajectory:
                     f"{path}: variable {nm} has shape {a.shape}, expected {lead + tail} "
                     f"(batch_shape {list(bshape)}, {t.shape[0]} times)"
                 )
+        if t.size > 1 and np.all(t == t[0]):
+            raise InvalidInputError(f"{path}: the time variable holds the same value {float(t[0])!r} for all "
+                                    f"{t.size} samples: the file was modified or is not ours")
         from .attitude.core import UNIT_QUATERNION_TOLERANCE
 
         with np.errstate(invalid="ignore", over="ignore"):

@@ -387,7 +387,6 @@ def test_body_at_rest_and_time_unit():
 
 
 def test_exact_solver_pictures_if_available():
-    pytest.importorskip("eulerpoisson.solvers.exact.motion", reason="the exact kernel is not written yet")
     from eulerpoisson.solvers import solve
 
     tr = solve(RACKET_I, np.linspace(0, 150, 601), omega0=RACKET_OMEGA0, method="exact")

@@ -193,11 +193,9 @@ def test_lie_series_terms_match_sympy_lie_derivatives():
 
 @pytest.mark.parametrize("case", ["diagonal_order8", "full_tensor_n0_order4"])
 def test_lie_series_terms_match_symbolic_audit(case):
-    try:
-        from eulerpoisson.paper.symbolic import lie_series
-    except ImportError:
-        pytest.skip("eulerpoisson.paper.symbolic (the audit's lie_series) is not available")
-    sp = pytest.importorskip("sympy")
+    sp = pytest.importorskip("sympy", reason="the symbolic extra (sympy) is not installed")
+    from eulerpoisson.paper.symbolic import lie_series
+
     pi0 = [sp.Rational(3, 2), sp.Rational(-1, 2), sp.Rational(1)]
     if case == "diagonal_order8":
         order = 8
@@ -436,10 +434,6 @@ def test_agrees_with_independent_references(name, inertia, w0, rel):
 
 
 def test_agrees_with_exact_method_to_t100():
-    try:
-        from eulerpoisson.solvers.exact.motion import exact_motion  # noqa: F401
-    except ImportError:
-        pytest.skip("eulerpoisson.solvers.exact.motion (the closed-form method) is not available yet")
     R = random_rotation(2)
     cases = [
         ([1.0, 2.0, 3.0], [1.0, 0.1, 0.5]),

@@ -23,7 +23,6 @@ import numpy as np
 
 from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import EulerPoissonError, MissingDependencyError
-from ..errors import require as require_module
 
 __all__ = ["main"]
 
@@ -427,25 +426,6 @@ def _torque_records(model) -> list[dict]:
     return [tq.to_dict() for tq in model.torques]
 
 
-def _first_and_last(path, model):
-    """The first and the last sample of a streamed trajectory store, as a Trajectory (reads two samples)."""
-    from ..trajectory import Trajectory
-
-    xr = require_module("xarray", "io")
-    with xr.open_zarr(str(path), consolidated=None) as ds:
-        idx = [0, ds.sizes["time"] - 1]
-        t = ds["time"].values[idx]
-        q = ds["quaternion"].isel(time=idx).values
-        w = ds["omega"].isel(time=idx).values
-        method = str(ds.attrs.get("method", ""))
-        options = json.loads(ds.attrs.get("method_options", "{}"))
-        bshape = tuple(json.loads(ds.attrs.get("batch_shape", "[]")))
-    if bshape:
-        q = q.reshape(bshape + q.shape[-2:])
-        w = w.reshape(bshape + w.shape[-2:])
-    return Trajectory(t, q, w, model.body, method, options, {}, torque=list(model.torques))
-
-
 def _state_json(traj, drift) -> dict:
     i = int(np.argmax(np.abs(traj.t)))  # the state at T (T < 0: backwards)
     q = traj.quaternion[..., i, :]
@@ -678,7 +658,10 @@ def cmd_simulate(args) -> int:
             except EulerPoissonError as exc:
                 raise type(exc)(str(exc).replace("pass overwrite=True", "run again with --overwrite")
                                 .replace("overwrite=True", "--overwrite")) from exc
-        traj = _first_and_last(out, model)
+        from ..trajectory import Trajectory
+
+        store = Trajectory.open(out)  # lazy: only the two samples below are read
+        traj = store[[0, len(store) - 1]]
         traj.stats["wall_time"] = time.perf_counter() - start
     else:
         t = np.linspace(0.0, t_end, samples)

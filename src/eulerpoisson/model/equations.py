@@ -53,21 +53,6 @@ __all__ = ["Model", "LagrangeTop", "as_model"]
 SYMMETRY_RTOL = 1e-12
 
 
-def _matrix(q):
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    R = np.empty(q.shape[:-1] + (3, 3))
-    R[..., 0, 0] = w * w + x * x - y * y - z * z
-    R[..., 0, 1] = 2 * (x * y - w * z)
-    R[..., 0, 2] = 2 * (x * z + w * y)
-    R[..., 1, 0] = 2 * (x * y + w * z)
-    R[..., 1, 1] = w * w - x * x + y * y - z * z
-    R[..., 1, 2] = 2 * (y * z - w * x)
-    R[..., 2, 0] = 2 * (x * z - w * y)
-    R[..., 2, 1] = 2 * (y * z + w * x)
-    R[..., 2, 2] = w * w - x * x - y * y + z * z
-    return R
-
-
 def _mv(A, v):
     return np.einsum("...ij,...j->...i", A, v)
 
@@ -194,7 +179,7 @@ class Model:
         if not self.torques:
             return out
         q = np.asarray(q, dtype=float)
-        R = _matrix(q)
+        R = matrix_from_unit_quaternion(q)
         inertia = self.body.inertia
         for tq in self.torques:
             if tq.kind == "callable":
@@ -260,7 +245,7 @@ class Model:
         U = np.zeros(q.shape[:-1])
         if not self.torques:
             return U
-        R = _matrix(q)
+        R = matrix_from_unit_quaternion(q)
         for tq in self.torques:
             if tq.conservative:
                 U = U + tq.potential(t, R, self.body.inertia)

@@ -59,6 +59,7 @@ __all__ = [
     "CallableTorque",
     "UnrecordedTorque",
     "PolynomialTorque",
+    "FlatPolynomialTorque",
     "as_torques",
     "torque_from_dict",
     "STANDARD_GRAVITY",
@@ -133,6 +134,43 @@ class PolynomialTorque:
     @property
     def has_orbit(self) -> bool:
         return bool(np.any(self.orbit_gain != 0))
+
+    def flatten(self, batch_shape) -> "FlatPolynomialTorque":
+        """The torque broadcast to ``batch_shape`` as flat per-body arrays (what the compiled kernels read)."""
+        B = int(np.prod(batch_shape, dtype=int))
+        tau0 = np.ascontiguousarray(np.broadcast_to(self.constant, batch_shape + (3,)).reshape(B, 3), dtype=float)
+        nv = len(self.vectors)
+        S = np.zeros((B, nv, 3))
+        L = np.zeros((B, nv, 3, 3))
+        for i, (s, Lm) in enumerate(zip(self.vectors, self.maps)):
+            S[:, i] = np.broadcast_to(s, batch_shape + (3,)).reshape(B, 3)
+            L[:, i] = np.broadcast_to(Lm, batch_shape + (3, 3)).reshape(B, 3, 3)
+        nu = np.ascontiguousarray(np.broadcast_to(self.orbit_rate, batch_shape).reshape(B), dtype=float)
+        kappa = np.ascontiguousarray(np.broadcast_to(self.orbit_gain, batch_shape).reshape(B), dtype=float)
+        return FlatPolynomialTorque(tau0, S, L, nu, kappa)
+
+
+@dataclass(frozen=True)
+class FlatPolynomialTorque:
+    """A :class:`PolynomialTorque` as flat per-body arrays: ``tau0`` (B, 3), ``S`` (B, nv, 3),
+    ``L`` (B, nv, 3, 3), ``nu`` and ``kappa`` (B,)."""
+
+    tau0: np.ndarray
+    S: np.ndarray
+    L: np.ndarray
+    nu: np.ndarray
+    kappa: np.ndarray
+
+    def in_frame(self, P) -> "FlatPolynomialTorque":
+        r"""The torque in a rotated body frame, :math:`\mathbf x' = P^T\mathbf x` (``P`` (B, 3, 3)).
+
+        The body-frame parts turn (:math:`\boldsymbol\tau_0' = P^T\boldsymbol\tau_0`,
+        :math:`L' = P^TLP`); the space vectors and the orbit do not (the orbit
+        term takes the inertia of the new frame).
+        """
+        tau0 = np.ascontiguousarray(np.einsum("bji,bj->bi", P, self.tau0))
+        L = np.ascontiguousarray(np.einsum("bji,bvjk,bkl->bvil", P, self.L, P))
+        return FlatPolynomialTorque(tau0, self.S, L, self.nu, self.kappa)
 
 
 class Torque:

@@ -156,8 +156,8 @@ def run_exact_splitting(moments, qp0, Mp0, data, t, dt, order):
         Attitudes of the principal axes.
     Mp0 : ndarray (B, 3)
         Principal-frame body angular momenta.
-    data : PolynomialData
-        The torque in the principal frame (constant, vectors, maps, orbit).
+    data : FlatPolynomialTorque
+        The torque in the principal frame (:meth:`~eulerpoisson.torques.PolynomialTorque.flatten`, ``in_frame``).
     t : ndarray (T,)
     dt : float
     order : int (2 or 4)

@@ -738,7 +738,6 @@ class Symplectic(Method):
 
     def _run_exact_splitting(self, problem: Problem, order: int, scheme: str) -> MethodResult:
         """The exact free flow composed with torque kicks, in the principal frame (:mod:`.exact_splitting`)."""
-        from ..taylor.torque import polynomial_data
         from .exact_splitting import run_exact_splitting
 
         cfg = self.config
@@ -752,9 +751,7 @@ class Symplectic(Method):
         w0 = problem.omega0.reshape(B, 3)
         qp0 = qmul(q0, qP)
         Mp0 = D * np.einsum("bji,bj->bi", P, w0)
-        data = polynomial_data(problem.model.polynomial(), bshape)
-        data.tau0 = np.ascontiguousarray(np.einsum("bji,bj->bi", P, data.tau0))
-        data.L = np.ascontiguousarray(np.einsum("bji,bvjk,bkl->bvil", P, data.L, P))
+        data = problem.model.polynomial().flatten(bshape).in_frame(P)
         dt = cfg["dt"]
         if dt is None:
             rate = np.sqrt(np.sum(w0 * w0, axis=-1))

@@ -647,7 +647,7 @@ class Taylor(Method):
 
     def _run_torque(self, problem: Problem) -> MethodResult:
         """Bodies under polynomial torques: (q, Omega) with Poisson vectors (:mod:`.torque`)."""
-        from .torque import integrate_polynomial, polynomial_data
+        from .torque import integrate_polynomial
 
         c = self.config
         if c["precision"] != "float64":
@@ -655,7 +655,7 @@ class Taylor(Method):
                                     f"the integration runs in float64 (precision='float64')")
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
-        data = polynomial_data(problem.model.polynomial(), bshape)
+        data = problem.model.polynomial().flatten(bshape)
         inertia = np.ascontiguousarray(problem.inertia.reshape(B, 3, 3))
         order = c["order"] if c["order"] is not None else (DEFAULT_FIXED_ORDER if c["dt"] is not None
                                                            else auto_order(float(c["tol"])))

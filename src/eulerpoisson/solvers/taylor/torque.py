@@ -52,40 +52,10 @@ from ...numerics.doubledouble import two_sum
 from ...numerics.quaternion import rotate_inverse
 from ...util.jit import USE_NUMBA
 
-__all__ = ["PolynomialData", "polynomial_data", "integrate_polynomial", "BACKEND"]
+__all__ = ["integrate_polynomial", "BACKEND"]
 
 #: which implementation runs: "numba" (compiled) or "python" (the same code, interpreted)
 BACKEND = "numba" if USE_NUMBA else "python"
-
-
-class PolynomialData:
-    """Flat per-body arrays of a model's polynomial torque (what the kernel reads).
-
-    Attributes
-    ----------
-    tau0 : ndarray (B, 3)
-    S : ndarray (B, nv, 3)
-    L : ndarray (B, nv, 3, 3)
-    nu, kappa : ndarray (B,)
-    """
-
-    def __init__(self, tau0, S, L, nu, kappa):
-        self.tau0, self.S, self.L, self.nu, self.kappa = tau0, S, L, nu, kappa
-
-
-def polynomial_data(poly, batch_shape) -> PolynomialData:
-    """Broadcast a :class:`~eulerpoisson.torques.PolynomialTorque` to ``batch_shape`` and flatten it."""
-    B = int(np.prod(batch_shape, dtype=int))
-    tau0 = np.ascontiguousarray(np.broadcast_to(poly.constant, batch_shape + (3,)).reshape(B, 3), dtype=float)
-    nv = len(poly.vectors)
-    S = np.zeros((B, max(nv, 1), 3))
-    L = np.zeros((B, max(nv, 1), 3, 3))
-    for i, (s, Lm) in enumerate(zip(poly.vectors, poly.maps)):
-        S[:, i] = np.broadcast_to(s, batch_shape + (3,)).reshape(B, 3)
-        L[:, i] = np.broadcast_to(Lm, batch_shape + (3, 3)).reshape(B, 3, 3)
-    nu = np.ascontiguousarray(np.broadcast_to(poly.orbit_rate, batch_shape).reshape(B), dtype=float)
-    kappa = np.ascontiguousarray(np.broadcast_to(poly.orbit_gain, batch_shape).reshape(B), dtype=float)
-    return PolynomialData(tau0, S[:, :nv] if nv else S[:, :0], L[:, :nv] if nv else L[:, :0], nu, kappa)
 
 
 # ---------------------------------------------------------------------------
@@ -370,7 +340,7 @@ if USE_NUMBA:  # pragma: no branch
     integrate_body = _njit(cache=True, nogil=True)(integrate_body)
 
 
-def integrate_polynomial(inertia, q0, w0, data: PolynomialData, t, *, tol, order, dt, max_steps):
+def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps):
     """Integrate a batch of bodies under polynomial torques.
 
     Parameters
@@ -378,7 +348,8 @@ def integrate_polynomial(inertia, q0, w0, data: PolynomialData, t, *, tol, order
     inertia : ndarray, shape (B, 3, 3)
     q0 : ndarray, shape (B, 4)
     w0 : ndarray, shape (B, 3)
-    data : PolynomialData
+    data : FlatPolynomialTorque
+        :meth:`~eulerpoisson.torques.PolynomialTorque.flatten`.
     t : ndarray, shape (T,)
         Output times, any order and sign.
     tol : float

@@ -24,6 +24,7 @@ from .model.equations import Model
 from . import torques
 from .solvers import available_methods, solve
 from .trajectory import Trajectory
+from .estimation import FitResult, fit
 from .model.formulations import FORMULATIONS, Formulation, formulation
 from .errors import (
     EulerPoissonError,
@@ -43,6 +44,8 @@ __all__ = [
     "solve",
     "available_methods",
     "Trajectory",
+    "fit",
+    "FitResult",
     "formulation",
     "Formulation",
     "FORMULATIONS",
@@ -72,6 +75,7 @@ _LAZY_MODULES = {
     "model": ".model",
     "testing": ".testing",
     "oracle": ".oracle",
+    "estimation": ".estimation",
 }
 
 

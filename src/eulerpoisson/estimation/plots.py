@@ -1,0 +1,162 @@
+"""Figures of a fit: residuals over time, fitted against observed attitude and rate, the fitted polhode.
+
+matplotlib is imported inside the functions (the ``plot`` extra).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["plot_residuals", "plot_fit", "plot_polhode", "save_plots"]
+
+_UNITS = {"attitude": "rad", "omega": "rate", "axis": "rad"}
+_LABELS = {"attitude": "attitude residual", "omega": "rate residual", "axis": "direction residual"}
+
+
+def _plt():
+    from ..errors import require
+
+    require("matplotlib", extra="plot")
+    import matplotlib
+
+    if matplotlib.get_backend().lower() not in ("agg", "module://matplotlib_inline.backend_inline"):
+        try:
+            matplotlib.use("Agg", force=False)
+        except Exception:  # pragma: no cover - a backend already in use
+            pass
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _kinds(result):
+    return [k for k in ("attitude", "omega", "axis") if k in result.residuals]
+
+
+def plot_residuals(result, ax=None):
+    """Residuals of each kind over time, divided by nothing (their units), with the sigma band."""
+    plt = _plt()
+    kinds = _kinds(result)
+    if ax is None:
+        fig, axes = plt.subplots(len(kinds), 1, figsize=(7, 2.3 * len(kinds) + 0.6), sharex=True, squeeze=False)
+        axes = axes[:, 0]
+    else:
+        fig, axes = ax.figure, [ax] * len(kinds)
+    for a, kind in zip(axes, kinds):
+        r = np.asarray(result.residuals[kind])
+        t = result.residuals[kind + "_t"]
+        names = "xyz" if r.shape[1] == 3 else ("across 1", "across 2")
+        for j in range(r.shape[1]):
+            a.plot(t, r[:, j], ".", ms=3, label=names[j])
+        s = result.sigma.get(kind)
+        if s is not None:
+            a.axhspan(-s, s, color="0.85", zorder=0, label="±σ")
+        a.set_ylabel(f"{_LABELS[kind]} [{_UNITS[kind]}]")
+        a.legend(loc="upper right", fontsize=7, ncol=4)
+    axes[-1].set_xlabel("t")
+    fig.suptitle(f"residuals: chi2/dof = {result.reduced_chi2:.3g}")
+    fig.tight_layout()
+    return fig
+
+
+def plot_fit(result, samples: int = 800):
+    """The fitted motion (lines, closed form) against the observations (dots): attitude quaternion and rate."""
+    plt = _plt()
+    obs = result.observations
+    t0, t1 = obs.t[0], obs.t[-1]
+    tt = np.linspace(t0, t1, samples)
+    tr = result.predict(tt)
+    panels = []
+    if len(obs.att_idx):
+        panels.append("attitude")
+    if len(obs.om_idx):
+        panels.append("omega")
+    if len(obs.ax_idx):
+        panels.append("axis")
+    fig, axes = plt.subplots(len(panels), 1, figsize=(7, 2.5 * len(panels) + 0.6), sharex=True, squeeze=False)
+    axes = axes[:, 0]
+    colors = ["C0", "C1", "C2", "C3"]
+    for a, kind in zip(axes, panels):
+        if kind == "attitude":
+            q = tr.quaternion
+            qo = obs.att_q.copy()
+            # the sign of each observed quaternion that matches the fitted one
+            qm = q[np.clip(np.searchsorted(tt, obs.t[obs.att_idx]), 0, samples - 1)]
+            qo *= np.where(np.sum(qo * qm, axis=1) < 0, -1.0, 1.0)[:, None]
+            for j, nm in enumerate("wxyz"):
+                a.plot(tt, q[:, j], color=colors[j], lw=1, label=f"q{nm}")
+                a.plot(obs.t[obs.att_idx], qo[:, j], ".", color=colors[j], ms=3)
+            a.set_ylabel("attitude quaternion")
+        elif kind == "omega":
+            w = tr.omega
+            if obs.omega_frame == "space":
+                w = np.einsum("kab,kb->ka", tr.matrix, w)
+            for j, nm in enumerate("xyz"):
+                a.plot(tt, w[:, j], color=colors[j], lw=1, label=f"ω{nm}")
+                a.plot(obs.t[obs.om_idx], obs.om_value[:, j], ".", color=colors[j], ms=3)
+            a.set_ylabel(f"angular velocity ({obs.omega_frame})")
+        else:
+            from ..attitude.core import matrix_from_unit_quaternion
+
+            d = matrix_from_unit_quaternion(tr.quaternion) @ obs.axis
+            for j, nm in enumerate("xyz"):
+                a.plot(tt, d[:, j], color=colors[j], lw=1, label=f"d{nm}")
+                a.plot(obs.t[obs.ax_idx], obs.ax_dir[:, j], ".", color=colors[j], ms=3)
+            a.set_ylabel("axis direction (space)")
+        a.legend(loc="upper right", fontsize=7, ncol=4)
+    axes[-1].set_xlabel("t")
+    fig.suptitle("fitted (lines) and observed (dots)")
+    fig.tight_layout()
+    return fig
+
+
+def plot_polhode(result, ax=None, samples: int = 2000):
+    """The body angular momentum of the fitted motion over one period of the polhode, in the principal frame."""
+    plt = _plt()
+    from ..analysis import momentum_period
+
+    V = result.principal_axes
+    ev = result.principal_moments
+    M0 = V.T @ (result.inertia @ result.omega0)
+    try:
+        period = float(momentum_period(ev, M0))
+    except Exception:  # a symmetric body or a rotation about an axis: no finite polhode period
+        period = None
+    span = period if period is not None and np.isfinite(period) else (result.observations.t[-1] - result.epoch)
+    tt = result.epoch + np.linspace(0.0, span, samples)
+    tr = result.predict(tt)
+    M = (tr.omega @ result.inertia.T) @ V  # principal-frame components
+    L = np.linalg.norm(M0)
+    if ax is None:
+        fig = plt.figure(figsize=(5.5, 5.5))
+        ax = fig.add_subplot(projection="3d")
+    else:
+        fig = ax.figure
+    u, v = np.mgrid[0:2 * np.pi:40j, 0:np.pi:20j]
+    ax.plot_wireframe(L * np.cos(u) * np.sin(v), L * np.sin(u) * np.sin(v), L * np.cos(v), color="0.85", lw=0.4)
+    ax.plot(M[:, 0], M[:, 1], M[:, 2], color="C3", lw=1.5, label="fitted polhode")
+    ax.set_xlabel("M1")
+    ax.set_ylabel("M2")
+    ax.set_zlabel("M3")
+    ax.set_title(f"polhode ({result.mode}), moments " + ", ".join(f"{x:.3f}" for x in ev))
+    return fig
+
+
+def save_plots(result, directory) -> list[Path]:
+    """Write the three figures as PNG files (atomically) into ``directory``; returns the paths."""
+    from ..io.atomic import atomic_path
+
+    plt = _plt()
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name, make in (("residuals.png", plot_residuals), ("fit.png", plot_fit), ("polhode.png", plot_polhode)):
+        fig = make(result)
+        path = d / name
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
+        plt.close(fig)
+        out.append(path)
+    return out

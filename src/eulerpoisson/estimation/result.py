@@ -1,0 +1,277 @@
+r"""What a fit returns: the body, the state at the epoch, their uncertainties, the residuals and the prediction."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..attitude.core import Attitude
+from ..numerics.quaternion import CONJUGATE, qmul
+from .residuals import inertia_matrix, log_quaternion
+
+__all__ = ["FitResult", "LocalOptimum"]
+
+
+@dataclass(frozen=True)
+class LocalOptimum:
+    """A distinct optimum the search reached: its :math:`\\chi^2`, inertia (trace 1), attitude and rate at the epoch."""
+
+    chi2: float
+    inertia: np.ndarray
+    q0: np.ndarray
+    omega0: np.ndarray
+    converged: bool
+
+    def as_dict(self) -> dict:
+        return {"chi2": float(self.chi2), "inertia": self.inertia.tolist(), "attitude0": self.q0.tolist(),
+                "omega0": self.omega0.tolist(), "converged": bool(self.converged)}
+
+
+def _covariance(J):
+    A = J.T @ J
+    try:
+        ev, V = np.linalg.eigh(A)
+    except np.linalg.LinAlgError:  # pragma: no cover - non-finite Jacobian is refused earlier
+        return np.full(A.shape, np.nan), False
+    ok = ev[0] > 1e-13 * ev[-1] and ev[0] > 0
+    if not ok:
+        return np.full(A.shape, np.nan), False
+    return (V / ev) @ V.T, True
+
+
+class FitResult:
+    r"""The torque-free body and spin state that best explain the observations (from :func:`eulerpoisson.fit`).
+
+    Attributes
+    ----------
+    epoch : float
+        Time of the fitted state, ``t[0]``.
+    inertia : ndarray, shape (3, 3)
+        Inertia tensor in the observations' body frame, trace 1 (free motion
+        fixes only the ratios).
+    attitude0 : Attitude
+        Attitude at the epoch (body to space).
+    omega0 : ndarray, shape (3,)
+        Body angular velocity at the epoch.
+    parameter_names : tuple of str
+        Names of the fitted unknowns: ``attitude0_x/y/z`` (a body-frame
+        rotation about ``attitude0``, radians; absent when the data do not see
+        the attitude), ``omega0_x/y/z``, then ``I_xx, I_yy`` (and ``I_xy,
+        I_xz, I_yz`` with ``principal_axes="fit"``); none of the inertia when
+        it was fixed.
+    parameters : dict
+        Their values (the attitude entries are 0: the rotation is about the fitted attitude).
+    covariance : ndarray, shape (P, P)
+        Covariance of the unknowns (NaN when the data do not determine them all).
+    stderr : dict
+        Standard errors by name, with ``I_zz`` derived and, when the axes are
+        fitted, the principal moments ``I_1 <= I_2 <= I_3``.
+    chi2, dof, reduced_chi2 : float, int, float
+        :math:`\sum r^2` of the whitened residuals, residuals minus unknowns, their ratio.
+    residuals : dict
+        Per kind present (``attitude``: body-frame rotation vectors, radians,
+        shape (Na, 3); ``omega``: (No, 3); ``axis``: (Nx, 2) radians), with
+        ``<kind>_t`` their times. Not divided by the sigmas.
+    sigma : dict
+        The standard deviations used (scalar summaries); ``sigma_estimated``
+        names the kinds whose sigma was estimated from the residuals.
+    local_optima : list of LocalOptimum
+        Distinct optima found by the search, best first.
+    """
+
+    def __init__(self, **kw):
+        for k, v in kw.items():
+            object.__setattr__(self, k, v)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("FitResult is read-only")
+
+    @classmethod
+    def _from_search(cls, layout, obs, best, final, optima, estimated, n_starts):
+        I, _ = inertia_matrix(layout, best.state.inertia_params)
+        I = I / np.trace(I)
+        J = final.jacobian
+        cov, determined = _covariance(J)
+        names = layout.names
+        values = {n: 0.0 for n in names[:layout.n_attitude]}
+        for i, n in enumerate(("omega0_x", "omega0_y", "omega0_z")):
+            values[n] = float(best.state.omega0[i])
+        for n, v in zip(names[layout.n_attitude + 3:], best.state.inertia_params):
+            values[n] = float(v)
+        se = np.sqrt(np.diag(cov))
+        stderr = {n: float(s) for n, s in zip(names, se)}
+        if layout.inertia_mode != "fixed":
+            ixx, iyy = names.index("I_xx"), names.index("I_yy")
+            values["I_zz"] = float(I[2, 2])
+            stderr["I_zz"] = float(np.sqrt(cov[ixx, ixx] + cov[iyy, iyy] + 2 * cov[ixx, iyy]))
+        ev, V = np.linalg.eigh(I)
+        V = V * np.where(np.linalg.det(V) < 0, -1.0, 1.0)
+        if layout.inertia_mode == "fit":
+            # first order: d lambda_i = v_i^T dI v_i
+            _, dI = inertia_matrix(layout, best.state.inertia_params)
+            G = np.einsum("ai,jab,bi->ij", V, dI, V)  # (3, Q)
+            sl = slice(layout.n_attitude + 3, None)
+            Cl = G @ cov[sl, sl] @ G.T
+            for i in range(3):
+                values[f"I_{i + 1}"] = float(ev[i])
+                stderr[f"I_{i + 1}"] = float(np.sqrt(Cl[i, i]))
+        residuals = {}
+        start = 0
+        res = final.residuals
+        for kind, idx, width, sig in (("attitude", obs.att_idx, 3, obs.att_sigma[:, None] if len(obs.att_idx) else None),
+                                      ("omega", obs.om_idx, 3, obs.om_sigma),
+                                      ("axis", obs.ax_idx, 2, obs.ax_sigma[:, None] if len(obs.ax_idx) else None)):
+            n = width * len(idx)
+            if n:
+                residuals[kind] = res[start:start + n].reshape(-1, width) * sig
+                residuals[kind + "_t"] = obs.t[idx]
+                start += n
+        sigma = {}
+        if len(obs.att_idx):
+            sigma["attitude"] = float(np.median(obs.att_sigma))
+        if len(obs.om_idx):
+            sigma["omega"] = float(np.median(obs.om_sigma))
+        if len(obs.ax_idx):
+            sigma["axis"] = float(np.median(obs.ax_sigma))
+        dof = len(res) - layout.n_params
+        return cls(
+            epoch=float(obs.t[0]), inertia=I, principal_moments=ev, principal_axes=V,
+            attitude0=Attitude(best.state.q0), omega0=best.state.omega0.copy(),
+            parameter_names=names, parameters=values, covariance=cov, stderr=stderr, determined=determined,
+            chi2=float(final.chi2), dof=int(dof), reduced_chi2=float(final.chi2 / dof) if dof > 0 else float("nan"),
+            residuals=residuals, sigma=sigma, sigma_estimated=tuple(sorted(estimated)),
+            local_optima=list(optima), converged=bool(best.converged), n_starts=int(n_starts),
+            principal_axes_mode=layout.inertia_mode, observations=obs, _model_q=final.quaternion,
+            _model_omega=final.omega, _model_rows=final.rows,
+        )
+
+    # ------------------------------------------------------------------
+    @property
+    def body(self):
+        """The fitted body, a :class:`~eulerpoisson.RigidBody` with the trace-1 tensor in the observations' frame."""
+        from ..model.body import RigidBody
+
+        return RigidBody(self.inertia, name="fitted body")
+
+    @property
+    def mode(self) -> str:
+        """``LAM`` (rotation about the long axis) or ``SAM`` (short axis) of the fitted motion."""
+        from .starts import regime
+
+        return regime(self.inertia, self.omega0)
+
+    def attitude_error(self, attitude) -> np.ndarray:
+        """Body-frame rotation vector (radians) from ``attitude`` to the fitted ``attitude0`` (shape (3,))."""
+        q = Attitude(attitude).as_quaternion() if not isinstance(attitude, Attitude) else attitude.as_quaternion()
+        return log_quaternion(qmul(q * CONJUGATE, self.attitude0.as_quaternion()))
+
+    def predict(self, t, **options):
+        """The fitted motion at times ``t`` (any, before or after the epoch), a :class:`~eulerpoisson.Trajectory`.
+
+        Solved in closed form (``method="exact"``) unless ``options`` say
+        otherwise (they go to :func:`eulerpoisson.solve`).
+        """
+        from ..solvers import solve
+        from ..trajectory import Trajectory
+        from ..util.validate import as_float_array
+
+        t = as_float_array(t, "t")
+        scalar = t.ndim == 0
+        t1 = np.atleast_1d(t)
+        tr = solve(self.body, t1 - self.epoch, attitude0=self.attitude0.as_quaternion(), omega0=self.omega0, **options)
+        out = Trajectory(t1, tr.quaternion, tr.omega, self.body, method=tr.method, options=tr.options, stats=tr.stats)
+        return out[0] if scalar else out
+
+    # ------------------------------------------------------------------
+    def as_dict(self) -> dict:
+        """Everything as plain Python (what :meth:`to_json` writes)."""
+        d = {
+            "epoch": self.epoch,
+            "inertia": self.inertia.tolist(),
+            "principal_moments": self.principal_moments.tolist(),
+            "principal_axes": self.principal_axes.tolist(),
+            "attitude0": self.attitude0.as_quaternion().tolist(),
+            "omega0": self.omega0.tolist(),
+            "mode": self.mode,
+            "parameters": dict(self.parameters),
+            "stderr": dict(self.stderr),
+            "parameter_names": list(self.parameter_names),
+            "covariance": [[None if not np.isfinite(x) else float(x) for x in row] for row in self.covariance],
+            "chi2": self.chi2,
+            "dof": self.dof,
+            "reduced_chi2": self.reduced_chi2,
+            "sigma": dict(self.sigma),
+            "sigma_estimated": list(self.sigma_estimated),
+            "converged": self.converged,
+            "principal_axes_mode": self.principal_axes_mode,
+            "n_observations": {k: int(len(v)) for k, v in self.residuals.items() if not k.endswith("_t")},
+            "local_optima": [o.as_dict() for o in self.local_optima],
+            "rms_residuals": {k: float(np.sqrt(np.mean(np.asarray(v) ** 2))) for k, v in self.residuals.items()
+                              if not k.endswith("_t")},
+        }
+        return d
+
+    def to_json(self, path=None, *, indent: int = 2) -> str:
+        """The result as JSON text; written atomically to ``path`` when given."""
+        text = json.dumps(self.as_dict(), indent=indent, allow_nan=False) + "\n"
+        if path is not None:
+            from ..io.atomic import atomic_write_text
+
+            atomic_write_text(path, text)
+        return text
+
+    def summary(self) -> str:
+        """A readable table: the body, the state, their standard errors, and the fit's quality."""
+        lines = []
+        kinds = ", ".join(f"{k} {len(v)}" for k, v in self.residuals.items() if not k.endswith("_t"))
+        lines.append(f"fit of a torque-free body: observations {kinds}; epoch t0 = {self.epoch:g}")
+        lines.append(f"  chi2 = {self.chi2:.6g}, dof = {self.dof}, reduced chi2 = {self.reduced_chi2:.4g}"
+                     + ("" if self.converged else "  (NOT converged)"))
+        if self.sigma_estimated:
+            lines.append("  sigma estimated from the residuals for: " + ", ".join(self.sigma_estimated))
+        lines.append(f"  {'parameter':<14}{'value':>16}{'stderr':>14}")
+        for n in list(self.parameter_names) + [k for k in ("I_zz", "I_1", "I_2", "I_3") if k in self.parameters]:
+            lines.append(f"  {n:<14}{self.parameters[n]:>16.9g}{self.stderr[n]:>14.3g}")
+        if not self.determined:
+            lines.append("  the data do not determine every unknown (singular normal matrix): fix the inertia or add data")
+        q = self.attitude0.as_quaternion()
+        lines.append("  attitude0 (w, x, y, z) = (" + ", ".join(f"{x:.9f}" for x in q) + ")"
+                     + ("  [attitude0_x/y/z: rotation about it, rad]" if "attitude0_x" in self.parameters else ""))
+        lines.append("  principal moments (trace 1) = (" + ", ".join(f"{x:.6f}" for x in self.principal_moments)
+                     + f"); motion: {self.mode}")
+        if len(self.local_optima) > 1:
+            lines.append(f"  {len(self.local_optima)} distinct optima from {self.n_starts} starts (chi2): "
+                         + ", ".join(f"{o.chi2:.6g}" for o in self.local_optima[:6]))
+        else:
+            lines.append(f"  one optimum from {self.n_starts} starts")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return f"<FitResult chi2={self.chi2:.4g} dof={self.dof} moments={np.round(self.principal_moments, 6).tolist()}>"
+
+    # ------------------------------------------------------------------
+    def plot_residuals(self, ax=None):
+        """Residuals over time, one panel per kind; returns the figure."""
+        from .plots import plot_residuals
+
+        return plot_residuals(self, ax=ax)
+
+    def plot_fit(self):
+        """Fitted (lines) against observed (dots) attitude and rate; returns the figure."""
+        from .plots import plot_fit
+
+        return plot_fit(self)
+
+    def plot_polhode(self, ax=None):
+        """The fitted polhode: the body angular momentum on its sphere, in the principal frame; returns the figure."""
+        from .plots import plot_polhode
+
+        return plot_polhode(self, ax=ax)
+
+    def save_plots(self, directory) -> list:
+        """Write ``residuals.png``, ``fit.png`` and ``polhode.png`` into ``directory``; returns their paths."""
+        from .plots import save_plots
+
+        return save_plots(self, directory)

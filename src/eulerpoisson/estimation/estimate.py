@@ -62,14 +62,19 @@ def _windows(obs, n_params):
     return ends
 
 
-def _continue(layout, obs, state, ends):
+#: standard deviation of the prior that holds the inertia near its start on the short windows
+PRIOR_SIGMA = 0.03
+
+
+def _continue(layout, obs, state, ends, max_iter=200):
     out = None
+    prior = (state.inertia_params.copy(), PRIOR_SIGMA)
     for j, t_end in enumerate(ends):
-        sub = obs.window(t_end) if j < len(ends) - 1 else obs
         final = j == len(ends) - 1
+        sub = obs if final else obs.window(t_end)
         try:
-            out = levenberg_marquardt(layout, sub, state, max_iter=200 if final else 40,
-                                      rtol=1e-12 if final else 1e-6)
+            out = levenberg_marquardt(layout, sub, state, max_iter=max_iter if final else 40,
+                                      rtol=1e-12 if final else 1e-6, prior=None if final else prior)
         except FloatingPointError:
             return None
         state = out.state
@@ -85,11 +90,16 @@ def _same(a: LocalOptimum, b: LocalOptimum) -> bool:
                 and ang < 1e-4)
 
 
-def _search(layout, obs, starts):
+def _search(layout, obs, starts, max_iter=200, direct=False):
     ends = _windows(obs, layout.n_params)
     found: list[tuple] = []
     for s in starts:
-        out = _continue(layout, obs, s, ends)
+        out = _continue(layout, obs, s, ends, max_iter)
+        if direct:
+            # a start the caller trusts: also straight to all the data, the better of the two kept
+            other = _continue(layout, obs, s, ends[-1:], max_iter)
+            if other is not None and (out is None or other.evaluation.chi2 < out.evaluation.chi2):
+                out = other
         if out is None:
             continue
         I, _ = inertia_matrix(layout, out.state.inertia_params)
@@ -214,7 +224,7 @@ def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, 
         start_list = make_starts(obs, layout, extra_inertias=seeds)
     else:
         start_list = make_starts(obs, layout)
-    found = _search(layout, obs, start_list)
+    found = _search(layout, obs, start_list, max_iter, direct=initial is not None)
     if not found:
         raise FitInputError("no start could be carried to an optimum (the motion could not be integrated)")
     estimated = {}

@@ -47,12 +47,28 @@ def retract(layout: Layout, state: FitState, delta) -> FitState:
     return FitState(q0, state.omega0 + delta[na:na + 3], state.inertia_params + delta[na + 3:])
 
 
-def _try(layout, obs, state):
+def _valid(layout, state):
     I, _ = inertia_matrix(layout, state.inertia_params)
-    if not inertia_valid(I):
-        return None
+    return inertia_valid(I)
+
+
+def _evaluate(layout, obs, state, prior):
+    """Evaluation, with the prior's rows ``(p - p0)/sigma`` on the inertia parameters appended when given."""
+    ev = evaluate(layout, obs, state)
+    if prior is None or not len(state.inertia_params):
+        return ev
+    p0, sig = prior
+    q = len(p0)
+    r = (state.inertia_params - p0) / sig
+    Jp = np.zeros((q, ev.jacobian.shape[1]))
+    Jp[:, -q:] = np.eye(q) / sig
+    res = np.concatenate([ev.residuals, r])
+    return Evaluation(res, np.vstack([ev.jacobian, Jp]), float(res @ res), ev.rows, ev.quaternion, ev.omega)
+
+
+def _try(layout, obs, state, prior):
     try:
-        ev = evaluate(layout, obs, state)
+        ev = _evaluate(layout, obs, state, prior)
     except FloatingPointError:
         return None
     if not np.isfinite(ev.chi2) or not np.all(np.isfinite(ev.jacobian)):
@@ -61,19 +77,22 @@ def _try(layout, obs, state):
 
 
 def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int = 200, rtol: float = 1e-12,
-                        evaluation: Evaluation | None = None) -> LMOutcome:
-    """Minimize the weighted sum of squares from ``state``.
+                        prior=None) -> LMOutcome:
+    r"""Minimize the weighted sum of squares from ``state``.
 
     Stops when a kept step lowers :math:`\\chi^2` by less than ``rtol`` relative
     and the step is small against the parameters' scale, when the gradient
-    vanishes, or after ``max_iter`` evaluations.
+    vanishes, or after ``max_iter`` evaluations. ``prior = (p0, sigma)`` adds
+    the rows :math:`(p - p_0)/\sigma` on the inertia parameters (used on the
+    short windows of the continuation, which barely see the inertia). A step
+    that leaves the physical inertias is halved until it stays inside.
 
     Raises
     ------
     FloatingPointError
         The motion cannot be integrated at the starting state.
     """
-    ev = evaluation if evaluation is not None else evaluate(layout, obs, state)
+    ev = _evaluate(layout, obs, state, prior)
     lam = None
     nu = 2.0
     it = 0
@@ -97,7 +116,12 @@ def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int =
             lam *= 10.0
             continue
         new_state = retract(layout, state, step)
-        new = _try(layout, obs, new_state)
+        for _ in range(30):
+            if _valid(layout, new_state):
+                break
+            step = 0.5 * step
+            new_state = retract(layout, state, step)
+        new = _try(layout, obs, new_state, prior) if _valid(layout, new_state) else None
         predicted = -(step @ g) - 0.5 * step @ (A @ step)  # decrease of chi2/2 by the linear model
         if new is not None and new.chi2 < ev.chi2:
             actual = 0.5 * (ev.chi2 - new.chi2)

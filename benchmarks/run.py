@@ -14,7 +14,10 @@ summary when present):
 ``torque``
     bodies under torque: taylor step cost with gravity against the free body, the exact Lagrange top
     per evaluation, the exact splitting's rate, accuracy of taylor and rk on a heavy top:
-    ``torque.json``.
+    ``torque.json``;
+``fit``
+    spin-state estimation (``ep.fit``) from the default starts: 100 observations (diagonal and full
+    inertia) and 10^4 observations: ``fit.json``.
 
 ``summary.md`` gathers the tables, the ratios against the peers measured in the same run and a
 PASS/MISS column for each goal of the issue, with the machine and the command. Every
@@ -50,7 +53,7 @@ if str(HERE) not in sys.path:
 import _common as C  # noqa: E402
 
 DEFAULT_OUT = HERE / "results"
-BENCHMARKS = ("work_precision", "long_run", "throughput", "torque")
+BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit")
 README = HERE / "README.md"
 README_START = "<!-- results:start -->"
 README_END = "<!-- results:end -->"
@@ -87,7 +90,7 @@ def _status(ok):
     return "PASS" if ok else "MISS"
 
 
-def evaluate_goals(wp, lr, tp, tq=None) -> list[dict]:
+def evaluate_goals(wp, lr, tp, tq=None, ft=None) -> list[dict]:
     """One row per goal of the issue: target, measured value(s), ratio to the peer, PASS/MISS/N/A."""
     goals = []
 
@@ -189,6 +192,16 @@ def evaluate_goals(wp, lr, tp, tq=None) -> list[dict]:
         g = {"goal": "exact: the Lagrange top <= 1 us per evaluation", "target": "<= 1 us per (body, time)",
              "measured": f"{r['value']:.3g} us per (body, time)", "ratio": r["value"], "status": _status(r["value"] <= 1.0)}
         goals.append(g)
+    if ft:
+        for name, limit in (("fit_100", 2.0), ("fit_100_full", 2.0), ("fit_10000", 20.0)):
+            r = _row(ft["rows"], name)
+            if r is None:
+                continue
+            g = {"goal": f"fit: {r['observations']} observations from the default starts under {limit:g} s "
+                         f"({r['label'].split('principal_axes=')[-1]})",
+                 "target": f"<= {limit:g} s", "measured": f"{r['value']:.3g} s, worst |z| {r['worst_z']:.2f}",
+                 "ratio": r["value"] / limit, "status": _status(r["value"] <= limit)}
+            goals.append(g)
     return goals
 
 
@@ -199,7 +212,7 @@ def _fmt_ratio(r):
     return "" if r is None else f"{r:.3g}"
 
 
-def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None) -> str:
+def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=None) -> str:
     L = []
     L.append("# Benchmark summary")
     L.append("")
@@ -285,6 +298,15 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None) -> str
         for r in tq["rows"]:
             e = r.get("attitude_error_rad")
             L.append(f"| {r['label']} | {r['value']:.3g} | {r['unit']} | {'-' if e is None else f'{e:.1e}'} |")
+    if ft:
+        L.append("")
+        L.append("## Spin-state estimation (one thread)")
+        L.append("")
+        L.append("| what | time (s) | starts | distinct optima | reduced chi2 | worst \\|z\\| |")
+        L.append("|---|---|---|---|---|---|")
+        for r in ft["rows"]:
+            L.append(f"| {r['label']} | {r['value']:.3g} | {r['starts']} | {r['optima']} | {r['reduced_chi2']:.3f} "
+                     f"| {r['worst_z']:.2f} |")
     L.append("")
     L.append("## Reference points quoted by the issue (2-core machine, not measured here)")
     L.append("")
@@ -355,19 +377,19 @@ def main(argv=None) -> int:
         elif path.exists():
             results[name] = json.loads(path.read_text())
     machine["load_average_at_end"] = C.load_average()
-    wp, lr, tp, tq = (results.get(n) for n in BENCHMARKS)
+    wp, lr, tp, tq, ft = (results.get(n) for n in BENCHMARKS)
     if args.summary_only:
         # describe the machine and command of the runs that produced the JSON, not of this call
-        runs = [r for r in (wp, lr, tp, tq) if r]
+        runs = [r for r in (wp, lr, tp, tq, ft) if r]
         if runs:
             machine, command = dict(runs[0]["machine"]), runs[0]["command"]
             ends = [r["machine"].get("load_average_at_end") for r in runs]
             machine["load_average_at_end"] = max((e for e in ends if e is not None), default=None)
             args.quick = bool(runs[0].get("quick"))
-    goals = evaluate_goals(wp, lr, tp, tq)
+    goals = evaluate_goals(wp, lr, tp, tq, ft)
     C.write_json(out / "goals.json", C.envelope("goals", quick=args.quick, command=command, machine=machine,
                                                 goals=goals))
-    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq)
+    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq, ft)
     (out / "summary.md").write_text(summary)
     print(f"  -> {out / 'summary.md'}")
     for g in goals:

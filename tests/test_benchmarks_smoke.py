@@ -98,6 +98,17 @@ def test_throughput_schema(quick_run):
         assert _pos(r["value"]) and r["unit"]
 
 
+def test_fit_schema(quick_run):
+    d = _load(quick_run, "fit")
+    rows = {r["name"]: r for r in d["rows"]}
+    assert {"fit_100", "fit_100_full", "fit_10000"} <= set(rows)
+    for r in rows.values():
+        assert _pos(r["value"]) and r["unit"] == "s"
+        # the fits find the truth: every parameter within 4 standard errors, chi2/dof near 1
+        assert r["worst_z"] < 4.0 and 0.7 < r["reduced_chi2"] < 1.3
+    assert "Spin-state estimation" in (quick_run / "summary.md").read_text()
+
+
 def test_summary_and_goals(quick_run):
     g = _load(quick_run, "goals")
     statuses = [x["status"] for x in g["goals"]]

@@ -1063,6 +1063,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .oracle import add_commands  # validate, cases (issue 14)
 
     add_commands(sub)
+    from .fit import add_commands as add_fit_command  # fit (issue 13)
+
+    add_fit_command(sub)
     return p
 
 

@@ -137,6 +137,11 @@ def plot_polhode(result, ax=None, samples: int = 2000):
     u, v = np.mgrid[0:2 * np.pi:40j, 0:np.pi:20j]
     ax.plot_wireframe(L * np.cos(u) * np.sin(v), L * np.sin(u) * np.sin(v), L * np.cos(v), color="0.85", lw=0.4)
     ax.plot(M[:, 0], M[:, 1], M[:, 2], color="C3", lw=1.5, label="fitted polhode")
+    obs = result.observations
+    if len(obs.om_idx) and obs.omega_frame == "body":
+        Mo = (obs.om_value @ result.inertia.T) @ V
+        ax.plot(Mo[:, 0], Mo[:, 1], Mo[:, 2], ".", color="k", ms=2.5, label="observed rates (as I Omega)")
+    ax.legend(loc="upper left", fontsize=7)
     ax.set_xlabel("M1")
     ax.set_ylabel("M2")
     ax.set_zlabel("M3")

@@ -230,15 +230,19 @@ class FitResult:
         lines.append(f"  chi2 = {self.chi2:.6g}, dof = {self.dof}, reduced chi2 = {self.reduced_chi2:.4g}"
                      + ("" if self.converged else "  (NOT converged)"))
         if self.sigma_estimated:
-            lines.append("  sigma estimated from the residuals for: " + ", ".join(self.sigma_estimated))
+            lines.append("  sigma estimated from the residuals: " + ", ".join(
+                f"{k} {self.sigma[k]:.3g}" for k in self.sigma_estimated))
         lines.append(f"  {'parameter':<14}{'value':>16}{'stderr':>14}")
         for n in list(self.parameter_names) + [k for k in ("I_zz", "I_1", "I_2", "I_3") if k in self.parameters]:
             lines.append(f"  {n:<14}{self.parameters[n]:>16.9g}{self.stderr[n]:>14.3g}")
         if not self.determined:
             lines.append("  the data do not determine every unknown (singular normal matrix): fix the inertia or add data")
         q = self.attitude0.as_quaternion()
-        lines.append("  attitude0 (w, x, y, z) = (" + ", ".join(f"{x:.9f}" for x in q) + ")"
-                     + ("  [attitude0_x/y/z: rotation about it, rad]" if "attitude0_x" in self.parameters else ""))
+        if "attitude0_x" in self.parameters:
+            lines.append("  attitude0 (w, x, y, z) = (" + ", ".join(f"{x:.9f}" for x in q) + ")"
+                         + "  [attitude0_x/y/z: rotation about it, rad]")
+        else:
+            lines.append("  attitude0: not seen by the data (body-frame rates only); predictions start from the identity")
         lines.append("  principal moments (trace 1) = (" + ", ".join(f"{x:.6f}" for x in self.principal_moments)
                      + f"); motion: {self.mode}")
         if len(self.local_optima) > 1:

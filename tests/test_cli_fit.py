@@ -166,3 +166,18 @@ def test_fixed_inertia_fits_the_state_only(capsys, tmp_path, good_rows):
     d = json.loads(out)
     assert not any(n.startswith("I_") for n in d["parameter_names"])
     assert np.allclose(d["omega0"], [0.2, 0.1, 1.0], atol=1e-9)
+
+
+def test_example_script_fits_and_predicts(tmp_path, capsys):
+    """examples/fit_phone_toss.py runs: both tosses fitted, figures and the prediction written."""
+    import runpy
+
+    mod = runpy.run_path(str(ROOT / "examples" / "fit_phone_toss.py"))
+    results = mod["main"](tmp_path / "phone_fit")
+    out = capsys.readouterr().out
+    assert "prediction from t <= 0.3 s" in out and "sigma apart" in out
+    assert (tmp_path / "phone_fit" / "prediction.png").stat().st_size > 0
+    for name in ("phone_toss_1", "phone_toss_2"):
+        assert sorted(p.name for p in (tmp_path / "phone_fit" / name).iterdir()) == \
+            ["fit.png", "polhode.png", "residuals.png"]
+        assert results[name].converged

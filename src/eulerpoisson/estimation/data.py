@@ -123,8 +123,18 @@ class ObservationSet:
         )
 
 
+def _array(x, name, tail=(), **kw) -> np.ndarray:
+    """:func:`as_float_array`, its InvalidInputError raised as FitInputError."""
+    try:
+        return as_float_array(x, name, tail, **kw)
+    except FitInputError:
+        raise
+    except InvalidInputError as exc:
+        raise FitInputError(str(exc)) from None
+
+
 def _times(t) -> np.ndarray:
-    t = as_float_array(t, "t")
+    t = _array(t, "t")
     if t.ndim != 1:
         raise FitInputError(f"t must be a 1-D array of observation times, shape (N,); got shape {t.shape}")
     if t.size < 2:
@@ -141,7 +151,7 @@ def _times(t) -> np.ndarray:
 
 
 def _rows(x, name, n, width) -> np.ndarray:
-    a = as_float_array(x, name, allow_nonfinite=True)
+    a = _array(x, name, allow_nonfinite=True)
     if a.shape != (n, width):
         raise FitInputError(f"{name} must have shape ({n}, {width}) (one row per time in t); got shape {a.shape}")
     if np.any(np.isinf(a)):
@@ -179,7 +189,7 @@ def _sigma(sig, name, n, width, present) -> tuple[np.ndarray, bool]:
     """Sigmas broadcast to (n, width); True when given."""
     if sig is None:
         return np.ones((n, width)), False
-    s = as_float_array(sig, name, allow_nonfinite=True)
+    s = _array(sig, name, allow_nonfinite=True)
     if s.ndim == 0:
         s = np.full((n, width), float(s))
     elif s.shape == (n,):
@@ -239,7 +249,7 @@ def observation_set(t, *, attitude=None, attitude_sigma=None, omega=None, omega_
     if axis_direction is not None:
         if axis is None:
             raise FitInputError("axis_direction is given without axis (the body axis whose space direction it is)")
-        a = as_float_array(axis, "axis", (3,))
+        a = _array(axis, "axis", (3,))
         if a.shape != (3,) or not np.linalg.norm(a) > 0:
             raise FitInputError(f"axis must be a non-zero body vector of shape (3,); got {a.tolist()}")
         a = a / np.linalg.norm(a)

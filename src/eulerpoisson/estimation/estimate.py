@@ -115,17 +115,27 @@ def _search(layout, obs, starts, max_iter=200, direct=False):
     return found
 
 
+#: an estimated sigma is at least this fraction of the observations' own scale (a perfect fit has none)
+SIGMA_FLOOR = 1e-12
+
+
 def _sigma_scales(layout, obs, ev):
     """Per kind, the factor that makes the whitened residuals of that kind unit variance."""
     n_total = len(ev.residuals)
     frac = max(1.0 - layout.n_params / n_total, 1e-3)
     scales = {}
     start = 0
-    for kind, n in (("attitude", 3 * len(obs.att_idx)), ("omega", 3 * len(obs.om_idx)), ("axis", 2 * len(obs.ax_idx))):
+    kinds = (("attitude", 3 * len(obs.att_idx), obs.att_sigma, 1.0),
+             ("omega", 3 * len(obs.om_idx), obs.om_sigma,
+              float(np.median(np.linalg.norm(obs.om_value, axis=1))) if len(obs.om_idx) else 1.0),
+             ("axis", 2 * len(obs.ax_idx), obs.ax_sigma, 1.0))
+    for kind, n, sig, ref in kinds:
         if n:
             r = ev.residuals[start:start + n]
             if not obs.sigma_given.get(kind, False):
-                scales[kind] = float(np.sqrt(max(r @ r, 1e-300) / (n * frac)))
+                current = float(np.median(sig))
+                floor = SIGMA_FLOOR * (ref if ref > 0 else 1.0) / current
+                scales[kind] = max(float(np.sqrt(r @ r / (n * frac))), floor)
             start += n
     return scales
 
@@ -201,6 +211,11 @@ def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, 
     D. W. Marquardt, J. SIAM 11 (1963) 431-441 (the search). Kaasalainen,
     A&A 376 (2001) 302 (spin states of tumbling asteroids).
     """
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)):
+        raise TypeError(f"max_iter must be a non-negative integer, got {type(max_iter).__name__} {max_iter!r}")
+    if max_iter < 0:
+        raise FitInputError(f"max_iter must be a non-negative integer, got {max_iter}")
+    max_iter = int(max_iter)
     obs = observation_set(t, attitude=attitude, attitude_sigma=attitude_sigma, omega=omega, omega_sigma=omega_sigma,
                           omega_frame=omega_frame, axis=axis, axis_direction=axis_direction, axis_sigma=axis_sigma)
     if principal_axes not in PRINCIPAL_AXES:
@@ -271,7 +286,10 @@ def _initial_state(initial, layout, obs):
         raise FitInputError("initial needs 'omega0'")
     w = np.asarray(w, dtype=float)
     if w.shape != (3,) or not np.all(np.isfinite(w)):
-        raise InvalidInputError(f"initial omega0 must be 3 finite numbers; got {w.tolist()}")
+        raise FitInputError(f"initial omega0 must be 3 finite numbers; got {w.tolist()}")
     q = initial.get("attitude0", [1.0, 0.0, 0.0, 0.0])
-    q = as_quaternion(q, "initial attitude0")
+    try:
+        q = as_quaternion(q, "initial attitude0")
+    except InvalidInputError as exc:
+        raise FitInputError(str(exc)) from None
     return FitState(q / np.linalg.norm(q), w, p)

@@ -29,6 +29,17 @@ class LocalOptimum:
                 "omega0": self.omega0.tolist(), "converged": bool(self.converged)}
 
 
+def _finite_or_none(x):
+    """A copy of nested dicts/lists with every non-finite float replaced by None (JSON has no NaN)."""
+    if isinstance(x, dict):
+        return {k: _finite_or_none(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite_or_none(v) for v in x]
+    if isinstance(x, float) and not np.isfinite(x):
+        return None
+    return x
+
+
 def _covariance(J):
     A = J.T @ J
     try:
@@ -83,9 +94,15 @@ class FitResult:
 
     def __init__(self, **kw):
         for k, v in kw.items():
+            if isinstance(v, np.ndarray):
+                v = v.copy()
+                v.flags.writeable = False
             object.__setattr__(self, k, v)
 
     def __setattr__(self, name, value):
+        raise AttributeError("FitResult is read-only")
+
+    def __delattr__(self, name):
         raise AttributeError("FitResult is read-only")
 
     @classmethod
@@ -186,7 +203,7 @@ class FitResult:
 
     # ------------------------------------------------------------------
     def as_dict(self) -> dict:
-        """Everything as plain Python (what :meth:`to_json` writes)."""
+        """Everything as plain Python (what :meth:`to_json` writes); NaN (undetermined) becomes None."""
         d = {
             "epoch": self.epoch,
             "inertia": self.inertia.tolist(),
@@ -198,7 +215,7 @@ class FitResult:
             "parameters": dict(self.parameters),
             "stderr": dict(self.stderr),
             "parameter_names": list(self.parameter_names),
-            "covariance": [[None if not np.isfinite(x) else float(x) for x in row] for row in self.covariance],
+            "covariance": self.covariance.tolist(),
             "chi2": self.chi2,
             "dof": self.dof,
             "reduced_chi2": self.reduced_chi2,
@@ -211,7 +228,7 @@ class FitResult:
             "rms_residuals": {k: float(np.sqrt(np.mean(np.asarray(v) ** 2))) for k, v in self.residuals.items()
                               if not k.endswith("_t")},
         }
-        return d
+        return _finite_or_none(d)
 
     def to_json(self, path=None, *, indent: int = 2) -> str:
         """The result as JSON text; written atomically to ``path`` when given."""

@@ -66,10 +66,9 @@ def omega_guess(obs: ObservationSet, q0=None) -> np.ndarray | None:
     """The body rate near the epoch from the data, or None."""
     if len(obs.om_idx):
         w = obs.om_value[0]
-        if obs.omega_frame == "space":
-            if q0 is None:
-                return None
+        if obs.omega_frame == "space" and q0 is not None:
             w = matrix_from_unit_quaternion(q0).T @ w
+        # space rates and no attitude: the start's attitude is the identity, where body and space rates agree
         return w.copy()
     if len(obs.att_idx) >= 2:
         dt = obs.t[obs.att_idx[1]] - obs.t[obs.att_idx[0]]

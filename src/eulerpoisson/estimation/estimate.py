@@ -5,6 +5,10 @@ The search
     continuation in time: Levenberg–Marquardt (:mod:`~eulerpoisson.estimation.lm`)
     first on the earliest observations, where a wrong inertia has not yet
     moved the motion far, then on windows twice as long, up to all of them.
+    The starts race: after each window, those whose :math:`\chi^2` is far
+    above the best (more than 100 times it plus 10 per residual; the truth's
+    is about 1 per residual) are dropped, and those that reached the same
+    state are merged.
     The distinct optima are kept with their :math:`\chi^2`; the best is the
     answer. With ``principal_axes="fit"`` a diagonal fit comes first and seeds
     the full one.
@@ -66,21 +70,6 @@ def _windows(obs, n_params):
 PRIOR_SIGMA = 0.03
 
 
-def _continue(layout, obs, state, ends, max_iter=200):
-    out = None
-    prior = (state.inertia_params.copy(), PRIOR_SIGMA)
-    for j, t_end in enumerate(ends):
-        final = j == len(ends) - 1
-        sub = obs if final else obs.window(t_end)
-        try:
-            out = levenberg_marquardt(layout, sub, state, max_iter=max_iter if final else 40,
-                                      rtol=1e-12 if final else 1e-6, prior=None if final else prior)
-        except FloatingPointError:
-            return None
-        state = out.state
-    return out
-
-
 def _same(a: LocalOptimum, b: LocalOptimum) -> bool:
     if abs(a.chi2 - b.chi2) > 1e-6 * (1.0 + min(a.chi2, b.chi2)):
         return False
@@ -90,28 +79,59 @@ def _same(a: LocalOptimum, b: LocalOptimum) -> bool:
                 and ang < 1e-4)
 
 
+#: after each window but the last, a start is dropped when its chi2 exceeds RACE_FACTOR times the best one's
+#: plus RACE_SLACK per residual: the truth's chi2 is about one per residual, so it always stays in the race
+RACE_FACTOR = 100.0
+RACE_SLACK = 10.0
+
+
+def _close(a, b, tol=1e-3) -> bool:
+    """Two states of the search that have reached the same place (to merge them)."""
+    ang = np.linalg.norm(log_quaternion(qmul(a.q0 * CONJUGATE, b.q0)))
+    scale = 1.0 + np.linalg.norm(a.omega0)
+    dp = np.abs(a.inertia_params - b.inertia_params).max() if len(a.inertia_params) else 0.0
+    return bool(ang < tol and np.abs(a.omega0 - b.omega0).max() < tol * scale and dp < tol)
+
+
+def _race(layout, obs, starts, ends, max_iter):
+    """Carry all starts through the windows together, dropping the clearly worse and merging the equal."""
+    live = [(s, (s.inertia_params.copy(), PRIOR_SIGMA)) for s in starts]
+    results = []
+    for j, t_end in enumerate(ends):
+        final = j == len(ends) - 1
+        sub = obs if final else obs.window(t_end)
+        results = []
+        for state, prior in live:
+            try:
+                out = levenberg_marquardt(layout, sub, state, max_iter=max_iter if final else 40,
+                                          rtol=1e-12 if final else 1e-6, prior=None if final else prior)
+            except FloatingPointError:
+                continue
+            results.append((out, prior))
+        if final or not results:
+            break
+        best = min(o.evaluation.chi2 for o, _ in results)
+        keep = RACE_FACTOR * best + RACE_SLACK * sub.n_residuals
+        merged = []
+        for o, p in sorted(results, key=lambda r: r[0].evaluation.chi2):
+            if o.evaluation.chi2 <= keep and not any(_close(o.state, m[0].state) for m in merged):
+                merged.append((o, p))
+        live = [(o.state, p) for o, p in merged]
+    return [o for o, _ in results]
+
+
 def _search(layout, obs, starts, max_iter=200, direct=False):
     ends = _windows(obs, layout.n_params)
+    outs = _race(layout, obs, starts, ends, max_iter)
+    if direct:
+        # starts the caller trusts: also straight to all the data
+        outs += _race(layout, obs, starts, ends[-1:], max_iter)
     found: list[tuple] = []
-    for s in starts:
-        out = _continue(layout, obs, s, ends, max_iter)
-        if direct:
-            # a start the caller trusts: also straight to all the data, the better of the two kept
-            other = _continue(layout, obs, s, ends[-1:], max_iter)
-            if other is not None and (out is None or other.evaluation.chi2 < out.evaluation.chi2):
-                out = other
-        if out is None:
-            continue
+    for out in sorted(outs, key=lambda o: o.evaluation.chi2):
         I, _ = inertia_matrix(layout, out.state.inertia_params)
         opt = LocalOptimum(out.evaluation.chi2, I, out.state.q0, out.state.omega0, out.converged)
         if not any(_same(opt, f[0]) for f in found):
             found.append((opt, out))
-        else:
-            # keep the lower chi2 of two copies of one optimum
-            for i, f in enumerate(found):
-                if _same(opt, f[0]) and opt.chi2 < f[0].chi2:
-                    found[i] = (opt, out)
-    found.sort(key=lambda f: f[0].chi2)
     return found
 
 

@@ -212,16 +212,33 @@ def starts(obs: ObservationSet, layout: Layout, *, extra_inertias=()) -> list[Fi
     out = []
     q_first = obs.att_q[0] if len(obs.att_idx) else None
     w = omega_guess(obs, q_first)
+    aliases = _aliases(obs, w) if w is not None and not len(obs.om_idx) else []
     for I in inertias:
         if w is None:
             ws = _omega_grid(obs)
         else:
-            ws = [w]
+            ws = [w] + aliases
         for w0 in ws:
             for q0 in attitude_guesses(obs, layout, I, w0):
                 out.append(FitState(q0, np.array(w0, dtype=float), params_of(mode, I) if mode != "fixed"
                                     else np.zeros(0)))
     return out
+
+
+def _aliases(obs: ObservationSet, w) -> list[np.ndarray]:
+    """Rates that turn the first two attitudes into each other with one more or one less turn.
+
+    Consecutive attitudes show the shortest rotation between them; a body that
+    turns more than half a turn between samples is seen aliased. These
+    starts cover one extra turn either way.
+    """
+    dt = obs.t[obs.att_idx[1]] - obs.t[obs.att_idx[0]]
+    phi = w * dt
+    a = float(np.linalg.norm(phi))
+    if a == 0.0:
+        return []
+    u = phi / a
+    return [(a + 2.0 * np.pi * k) * u / dt for k in (1, -1)]
 
 
 def _omega_grid(obs: ObservationSet):

@@ -5,10 +5,17 @@ The search
     continuation in time: Levenberg–Marquardt (:mod:`~eulerpoisson.estimation.lm`)
     first on the earliest observations, where a wrong inertia has not yet
     moved the motion far, then on windows twice as long, up to all of them.
-    The starts race: after each window, those whose :math:`\chi^2` is far
-    above the best (more than 100 times it plus 10 per residual; the truth's
-    is about 1 per residual) are dropped, and those that reached the same
+    The starts race: after each window, those whose :math:`\chi^2` is more
+    than 100 times the best are dropped, and those that reached the same
     state are merged.
+
+Equivalent optima
+    Evenly spaced samples alias: a motion turning one more time between
+    samples (about an axis that barely moves, e.g. a nearly spherical body)
+    can fit as well as the slow one. Among optima within
+    :math:`\Delta\chi^2 < 1` of the best, the slowest (smallest
+    :math:`|\boldsymbol\Omega_0|`) is reported, and the summary says how
+    many fit equally well.
     The distinct optima are kept with their :math:`\chi^2`; the best is the
     answer. With ``principal_axes="fit"`` a diagonal fit comes first and seeds
     the full one.
@@ -17,7 +24,8 @@ Weights
     Each residual is divided by its standard deviation. A kind whose standard
     deviation is not given gets one estimated from its residuals at the
     optimum, :math:`\hat\sigma^2 = \sum r^2 / (n(1 - p/N))` (``n`` residuals of
-    that kind out of ``N``, ``p`` unknowns), and the fit is repeated with it.
+    that kind out of ``N``, ``p`` unknowns): from a first search with unit
+    sigmas, then again at the optimum of the search proper until it settles.
 
 Uncertainties
     :math:`C = (J^\mathsf TJ)^{-1}` of the whitened Jacobian at the optimum, the
@@ -33,7 +41,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..numerics.quaternion import CONJUGATE, qmul
 from .data import FitInputError, observation_set
-from .lm import levenberg_marquardt
+from .lm import LMOutcome, levenberg_marquardt
 from .residuals import FitState, Layout, evaluate, inertia_matrix, inertia_valid, log_quaternion
 from .result import FitResult, LocalOptimum
 from .starts import params_of, starts as make_starts
@@ -80,9 +88,11 @@ def _same(a: LocalOptimum, b: LocalOptimum) -> bool:
 
 
 #: after each window but the last, a start is dropped when its chi2 exceeds RACE_FACTOR times the best one's
-#: plus RACE_SLACK per residual: the truth's chi2 is about one per residual, so it always stays in the race
+#: (relative, so that the units of the sigmas do not matter; a fit to noise cannot beat the truth by 100x)
 RACE_FACTOR = 100.0
-RACE_SLACK = 10.0
+
+#: optima within this chi2 of the best (at least; 1e-9 relative) fit the data equally well
+EQUIVALENT_CHI2 = 1.0
 
 
 def _close(a, b, tol=1e-3) -> bool:
@@ -111,7 +121,7 @@ def _race(layout, obs, starts, ends, max_iter):
         if final or not results:
             break
         best = min(o.evaluation.chi2 for o, _ in results)
-        keep = RACE_FACTOR * best + RACE_SLACK * sub.n_residuals
+        keep = RACE_FACTOR * max(best, 1e-300)
         merged = []
         for o, p in sorted(results, key=lambda r: r[0].evaluation.chi2):
             if o.evaluation.chi2 <= keep and not any(_close(o.state, m[0].state) for m in merged):
@@ -249,7 +259,17 @@ def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, 
             f"too few observations: {obs.n_residuals} residuals for {layout.n_params} unknowns "
             f"({', '.join(layout.names)}); give more observations or fix the inertia"
         )
-    # provisional weights of kinds without sigma: unit residual scale per kind, refined after the fit
+    estimated = {}
+    if not all(obs.sigma_given.get(k, False) for k in obs.kinds):
+        # kinds without sigma: a first search with unit sigmas gives their scale, so that the search proper
+        # (its race and its prior on short windows) sees residuals of about one per observation
+        pre_layout = Layout(layout.fit_attitude, "given") if layout.inertia_mode == "fit" else layout
+        pre_starts = [_initial_state(initial, pre_layout, obs)] if initial is not None else make_starts(obs, pre_layout)
+        pre = _search(pre_layout, obs, pre_starts, max_iter, direct=initial is not None)
+        if pre:
+            scales = _sigma_scales(pre_layout, obs, pre[0][1].evaluation)
+            obs = obs.with_sigmas(scales)
+            estimated = dict(scales)
     if initial is not None:
         start_list = [_initial_state(initial, layout, obs)]
     elif layout.inertia_mode == "fit":
@@ -262,7 +282,6 @@ def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, 
     found = _search(layout, obs, start_list, max_iter, direct=initial is not None)
     if not found:
         raise FitInputError("no start could be carried to an optimum (the motion could not be integrated)")
-    estimated = {}
     for _ in range(3):
         scales = _sigma_scales(layout, obs, found[0][1].evaluation)
         if not scales or all(abs(s - 1.0) < 1e-3 for s in scales.values()):
@@ -271,19 +290,35 @@ def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, 
         for k, s in scales.items():
             estimated[k] = estimated.get(k, 1.0) * s
         refined = []
+        best_chi2 = found[0][0].chi2
         for opt, out in found:
-            again = levenberg_marquardt(layout, obs, out.state, max_iter=max_iter)
+            if opt.chi2 <= RACE_FACTOR * max(best_chi2, 1e-300):
+                again = levenberg_marquardt(layout, obs, out.state, max_iter=max_iter)
+            else:  # far worse: re-weighed, not refitted
+                again = LMOutcome(out.state, evaluate(layout, obs, out.state), 0, out.converged)
             I, _ = inertia_matrix(layout, again.state.inertia_params)
             refined.append((LocalOptimum(again.evaluation.chi2, I, again.state.q0, again.state.omega0,
                                          again.converged), again))
         found = sorted(refined, key=lambda f: f[0].chi2)
+    found, n_equivalent = _prefer_slowest(found)
     best = found[0][1]
     final = evaluate(layout, obs, best.state)
-    return FitResult._from_search(layout, obs, best, final, [f[0] for f in found], estimated, len(start_list))
+    return FitResult._from_search(layout, obs, best, final, [f[0] for f in found], estimated, len(start_list),
+                                  n_equivalent)
+
+
+def _prefer_slowest(found):
+    """Put first, among the optima that fit as well as the best, the one with the slowest rate."""
+    best = found[0][0].chi2
+    limit = best + max(EQUIVALENT_CHI2, 1e-9 * best)
+    eq = [f for f in found if f[0].chi2 <= limit]
+    slow = min(eq, key=lambda f: float(np.linalg.norm(f[0].omega0)))
+    rest = [f for f in found if f is not slow]
+    return [slow] + rest, len(eq)
 
 
 def _initial_state(initial, layout, obs):
-    from ..attitude.core import as_quaternion
+    from ..attitude.core import Attitude, as_quaternion, quaternion_from_scipy
 
     if not isinstance(initial, dict):
         raise TypeError(f"initial must be a dict with inertia, omega0 and attitude0; got {type(initial).__name__}")
@@ -292,6 +327,8 @@ def _initial_state(initial, layout, obs):
         raise FitInputError(f"initial has unknown keys {sorted(unknown)}; expected inertia, omega0, attitude0")
     I = initial.get("inertia")
     if layout.inertia_mode == "fixed":
+        if I is not None:
+            raise FitInputError("initial has an inertia, but inertia= fixes it: give one or the other")
         p = np.zeros(0)
     else:
         if I is None:
@@ -308,8 +345,14 @@ def _initial_state(initial, layout, obs):
     if w.shape != (3,) or not np.all(np.isfinite(w)):
         raise FitInputError(f"initial omega0 must be 3 finite numbers; got {w.tolist()}")
     q = initial.get("attitude0", [1.0, 0.0, 0.0, 0.0])
+    if isinstance(q, Attitude):
+        q = q.as_quaternion()
+    elif type(q).__module__.startswith("scipy.spatial.transform"):
+        q = quaternion_from_scipy(q)
     try:
         q = as_quaternion(q, "initial attitude0")
     except InvalidInputError as exc:
         raise FitInputError(str(exc)) from None
+    if q.shape != (4,):
+        raise FitInputError(f"initial attitude0 must be one attitude (4 quaternion components); got shape {q.shape}")
     return FitState(q / np.linalg.norm(q), w, p)

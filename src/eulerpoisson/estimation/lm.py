@@ -104,7 +104,7 @@ def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int =
         d = np.diag(A).copy()
         dmax = d.max() if d.size else 1.0
         d = np.maximum(d, 1e-12 * dmax + 1e-300)
-        if np.max(np.abs(g)) <= 1e-14 * (1.0 + ev.chi2) * np.sqrt(dmax):
+        if np.max(np.abs(g)) <= 1e-14 * (ev.chi2 + 1e-300) * np.sqrt(dmax):
             converged = True
             break
         if lam is None:
@@ -126,7 +126,7 @@ def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int =
         if new is not None and new.chi2 < ev.chi2:
             actual = 0.5 * (ev.chi2 - new.chi2)
             rho = actual / predicted if predicted > 0 else 0.0
-            small = np.sqrt(step @ (d * step)) <= 1e-9 * (1.0 + np.sqrt(ev.chi2))
+            small = np.sqrt(step @ (d * step)) <= 1e-9 * np.sqrt(ev.chi2 + 1e-300)
             rel = (ev.chi2 - new.chi2) <= rtol * ev.chi2
             state, ev = new_state, new
             lam *= max(1.0 / 3.0, 1.0 - (2.0 * rho - 1.0) ** 3)
@@ -137,7 +137,7 @@ def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int =
                 break
         else:
             if new is not None and (ev.chi2 - new.chi2) >= -1e-15 * ev.chi2 and \
-                    np.sqrt(step @ (d * step)) <= 1e-9 * (1.0 + np.sqrt(ev.chi2)):
+                    np.sqrt(step @ (d * step)) <= 1e-9 * np.sqrt(ev.chi2 + 1e-300):
                 converged = True  # at round-off level
                 break
             lam *= nu

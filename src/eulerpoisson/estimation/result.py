@@ -3,6 +3,7 @@ r"""What a fit returns: the body, the state at the epoch, their uncertainties, t
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,14 +25,35 @@ class LocalOptimum:
     omega0: np.ndarray
     converged: bool
 
+    def __post_init__(self):
+        for name in ("inertia", "q0", "omega0"):
+            a = np.array(getattr(self, name), dtype=float)
+            a.flags.writeable = False
+            object.__setattr__(self, name, a)
+
     def as_dict(self) -> dict:
         return {"chi2": float(self.chi2), "inertia": self.inertia.tolist(), "attitude0": self.q0.tolist(),
                 "omega0": self.omega0.tolist(), "converged": bool(self.converged)}
 
 
+def _frozen(v):
+    """Read-only copies: arrays not writeable, dicts as read-only mappings (nested), lists as tuples."""
+    from types import MappingProxyType
+
+    if isinstance(v, np.ndarray):
+        v = v.copy()
+        v.flags.writeable = False
+        return v
+    if isinstance(v, dict):
+        return MappingProxyType({k: _frozen(x) for k, x in v.items()})
+    if isinstance(v, list):
+        return tuple(_frozen(x) for x in v)
+    return v
+
+
 def _finite_or_none(x):
     """A copy of nested dicts/lists with every non-finite float replaced by None (JSON has no NaN)."""
-    if isinstance(x, dict):
+    if isinstance(x, Mapping):
         return {k: _finite_or_none(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
         return [_finite_or_none(v) for v in x]
@@ -88,16 +110,13 @@ class FitResult:
     sigma : dict
         The standard deviations used (scalar summaries); ``sigma_estimated``
         names the kinds whose sigma was estimated from the residuals.
-    local_optima : list of LocalOptimum
+    local_optima : tuple of LocalOptimum
         Distinct optima found by the search, best first.
     """
 
     def __init__(self, **kw):
         for k, v in kw.items():
-            if isinstance(v, np.ndarray):
-                v = v.copy()
-                v.flags.writeable = False
-            object.__setattr__(self, k, v)
+            object.__setattr__(self, k, _frozen(v))
 
     def __setattr__(self, name, value):
         raise AttributeError("FitResult is read-only")
@@ -106,7 +125,7 @@ class FitResult:
         raise AttributeError("FitResult is read-only")
 
     @classmethod
-    def _from_search(cls, layout, obs, best, final, optima, estimated, n_starts):
+    def _from_search(cls, layout, obs, best, final, optima, estimated, n_starts, n_equivalent=1):
         I, _ = inertia_matrix(layout, best.state.inertia_params)
         I = I / np.trace(I)
         J = final.jacobian
@@ -160,7 +179,7 @@ class FitResult:
             chi2=float(final.chi2), dof=int(dof), reduced_chi2=float(final.chi2 / dof) if dof > 0 else float("nan"),
             residuals=residuals, sigma=sigma, sigma_estimated=tuple(sorted(estimated)),
             local_optima=list(optima), converged=bool(best.converged), n_starts=int(n_starts),
-            principal_axes_mode=layout.inertia_mode, observations=obs, _model_q=final.quaternion,
+            principal_axes_mode=layout.inertia_mode, observations=obs, n_equivalent=int(n_equivalent), _model_q=final.quaternion,
             _model_omega=final.omega, _model_rows=final.rows,
         )
 
@@ -262,6 +281,9 @@ class FitResult:
             lines.append("  attitude0: not seen by the data (body-frame rates only); predictions start from the identity")
         lines.append("  principal moments (trace 1) = (" + ", ".join(f"{x:.6f}" for x in self.principal_moments)
                      + f"); motion: {self.mode}")
+        if self.n_equivalent > 1:
+            lines.append(f"  {self.n_equivalent} optima fit the data equally well (delta chi2 < 1; evenly spaced "
+                         f"samples alias): the slowest motion is reported, see local_optima")
         if len(self.local_optima) > 1:
             lines.append(f"  {len(self.local_optima)} distinct optima from {self.n_starts} starts (chi2): "
                          + ", ".join(f"{o.chi2:.6g}" for o in self.local_optima[:6]))

@@ -29,7 +29,7 @@ from ..attitude.core import Attitude, quaternion_from_scipy
 from ..errors import InvalidInputError
 from ..util.validate import as_float_array
 
-__all__ = ["ObservationSet", "observation_set", "FitInputError"]
+__all__ = ["ObservationSet", "observation_set", "quaternion_array", "FitInputError"]
 
 #: norm tolerance of observed unit quaternions and directions (as everywhere in the package)
 UNIT_TOL = 1e-6
@@ -163,26 +163,30 @@ def _rows(x, name, n, width) -> np.ndarray:
     return a
 
 
-def _quaternions(attitude, n) -> np.ndarray:
+def quaternion_array(attitude):
+    """Quaternions (w, x, y, z) of an :class:`~eulerpoisson.Attitude`, a scipy ``Rotation`` or an array (unchecked)."""
     if isinstance(attitude, Attitude):
-        q = attitude.as_quaternion()
-    elif type(attitude).__module__.startswith("scipy.spatial.transform"):
-        q = quaternion_from_scipy(attitude)
-    else:
-        q = attitude
-    q = _rows(q, "attitude", n, 4)
-    ok = ~np.isnan(q[:, 0])
-    nrm = np.linalg.norm(q[ok], axis=1)
-    bad = np.abs(nrm - 1.0) > UNIT_TOL
-    if np.any(bad):
-        i = int(np.flatnonzero(ok)[np.flatnonzero(bad)[0]])
-        raise FitInputError(
-            f"attitude row {i} is not a unit quaternion (norm {nrm[np.flatnonzero(bad)[0]]!r}; "
-            f"expected 1 within {UNIT_TOL:g})"
-        )
-    q = q.copy()
-    q[ok] /= nrm[:, None]
-    return q
+        return attitude.as_quaternion()
+    if type(attitude).__module__.startswith("scipy.spatial.transform"):
+        return quaternion_from_scipy(attitude)
+    return attitude
+
+
+def _unit_rows(a, name, what) -> np.ndarray:
+    """Rows of ``a`` normalized; NaN rows kept; a present row off unit norm by more than UNIT_TOL is an error."""
+    ok = ~np.isnan(a[:, 0])
+    nrm = np.linalg.norm(a[ok], axis=1)
+    bad = np.flatnonzero(np.abs(nrm - 1.0) > UNIT_TOL)
+    if bad.size:
+        i = int(np.flatnonzero(ok)[bad[0]])
+        raise FitInputError(f"{name} row {i} is not a {what} (norm {nrm[bad[0]]!r}; expected 1 within {UNIT_TOL:g})")
+    a = a.copy()
+    a[ok] /= nrm[:, None]
+    return a
+
+
+def _quaternions(attitude, n) -> np.ndarray:
+    return _unit_rows(_rows(quaternion_array(attitude), "attitude", n, 4), "attitude", "unit quaternion")
 
 
 def _sigma(sig, name, n, width, present) -> tuple[np.ndarray, bool]:
@@ -253,15 +257,10 @@ def observation_set(t, *, attitude=None, attitude_sigma=None, omega=None, omega_
         if a.shape != (3,) or not np.linalg.norm(a) > 0:
             raise FitInputError(f"axis must be a non-zero body vector of shape (3,); got {a.tolist()}")
         a = a / np.linalg.norm(a)
-        d = _rows(axis_direction, "axis_direction", n, 3)
+        d = _unit_rows(_rows(axis_direction, "axis_direction", n, 3), "axis_direction", "unit vector")
         present = ~np.isnan(d[:, 0])
-        nrm = np.linalg.norm(d[present], axis=1)
-        bad = np.abs(nrm - 1.0) > UNIT_TOL
-        if np.any(bad):
-            i = int(np.flatnonzero(present)[np.flatnonzero(bad)[0]])
-            raise FitInputError(f"axis_direction row {i} is not a unit vector (norm {nrm[np.flatnonzero(bad)[0]]!r})")
         s, given["axis"] = _sigma(axis_sigma, "axis_sigma", n, 1, present)
-        ax_idx, ax_d, ax_s = np.flatnonzero(present), d[present] / nrm[:, None], s[present, 0]
+        ax_idx, ax_d, ax_s = np.flatnonzero(present), d[present], s[present, 0]
     elif axis_sigma is not None:
         raise FitInputError("axis_sigma is given without axis_direction observations")
     elif axis is not None:

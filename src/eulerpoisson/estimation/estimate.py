@@ -40,7 +40,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..numerics.quaternion import CONJUGATE, qmul
-from .data import FitInputError, observation_set
+from .data import FitInputError, observation_set, quaternion_array
 from .lm import LMOutcome, levenberg_marquardt
 from .residuals import FitState, Layout, evaluate, inertia_matrix, inertia_valid, log_quaternion
 from .result import FitResult, LocalOptimum
@@ -318,7 +318,7 @@ def _prefer_slowest(found):
 
 
 def _initial_state(initial, layout, obs):
-    from ..attitude.core import Attitude, as_quaternion, quaternion_from_scipy
+    from ..attitude.core import as_quaternion
 
     if not isinstance(initial, dict):
         raise TypeError(f"initial must be a dict with inertia, omega0 and attitude0; got {type(initial).__name__}")
@@ -345,12 +345,8 @@ def _initial_state(initial, layout, obs):
     if w.shape != (3,) or not np.all(np.isfinite(w)):
         raise FitInputError(f"initial omega0 must be 3 finite numbers; got {w.tolist()}")
     q = initial.get("attitude0", [1.0, 0.0, 0.0, 0.0])
-    if isinstance(q, Attitude):
-        q = q.as_quaternion()
-    elif type(q).__module__.startswith("scipy.spatial.transform"):
-        q = quaternion_from_scipy(q)
     try:
-        q = as_quaternion(q, "initial attitude0")
+        q = as_quaternion(quaternion_array(q), "initial attitude0")
     except InvalidInputError as exc:
         raise FitInputError(str(exc)) from None
     if q.shape != (4,):

@@ -235,7 +235,6 @@ def _propagate_numpy(I, J, dI, omega0, tau, order, tol, safety, max_steps, q, w,
 # ---------------------------------------------------------------------------
 def _propagate_loops(I, J, dI, omega0, tau, order, tol, safety, max_steps, q, w, eta, dw):
     P = eta.shape[1]
-    Qn = dI.shape[0]
     K = tau.shape[0]
     n1 = order + 1
     W = np.zeros((n1, 3))

@@ -304,9 +304,14 @@ class Trajectory:
         MissingDependencyError
             If xarray is not installed (extra ``io``).
         """
+        xr = require("xarray", "io")
+        data, coords, attrs = self._netcdf_content()
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+    def _netcdf_content(self):
+        """The variables ``{name: (dims, values, attrs)}``, coordinates and global attributes of the file."""
         from . import __version__
 
-        xr = require("xarray", "io")
         bshape = self.batch_shape
         nb = int(np.prod(bshape)) if bshape else 0
         T = len(self.t)
@@ -365,7 +370,7 @@ class Trajectory:
             "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} written by eulerpoisson {__version__}",
             "references": "A. A. Deriglazov, Geodesic motion on the symplectic leaf of SO(3) ... (the paper)",
         }
-        return xr.Dataset(data, coords=coords, attrs=attrs)
+        return data, coords, attrs
 
     def to_netcdf(self, path) -> None:
         """Write the trajectory to a NetCDF-4 file, atomically (temporary file, then rename).
@@ -377,13 +382,37 @@ class Trajectory:
         """
         import io
 
-        ds = self.to_xarray()
-        require("h5netcdf", "io")
+        h5netcdf = require("h5netcdf", "io")
+        content, coords, attrs = self._netcdf_content()
         # HDF5 writes into memory first; the file itself is written by plain Python I/O, so a full disk is
         # an OSError naming the file (HDF5 left with a half-written file on a full disk crashed the
-        # interpreter at exit), and nothing is left behind
+        # interpreter at exit), and nothing is left behind. h5netcdf directly, not through xarray: the
+        # same file (xarray reads back the dataset of to_xarray(), a test checks) without importing
+        # xarray and dask on every run of the command line.
+        variables = {name: (v if len(v) == 3 else (*v, {})) for name, v in {**coords, **content}.items()}
+        dims: dict[str, int] = {}
+        for dnames, values, _ in variables.values():
+            dnames = (dnames,) if isinstance(dnames, str) else tuple(dnames)
+            for d, n in zip(dnames, np.shape(values)):
+                dims.setdefault(d, n)
         buf = io.BytesIO()
-        ds.to_netcdf(buf, engine="h5netcdf")
+        with h5netcdf.File(buf, "w") as f:
+            f.dimensions = dims
+            for name, (dnames, values, vattrs) in variables.items():
+                dnames = (dnames,) if isinstance(dnames, str) else tuple(dnames)
+                values = np.asarray(values)
+                if values.dtype.kind == "U":
+                    import h5py
+
+                    var = f.create_variable(name, dnames, dtype=h5py.string_dtype())
+                    var[...] = values.astype(object)
+                else:
+                    var = f.create_variable(name, dnames, dtype=values.dtype, data=values,
+                                            fillvalue=np.nan if values.dtype.kind == "f" else None)
+                for k, val in vattrs.items():
+                    var.attrs[k] = val
+            for k, val in attrs.items():
+                f.attrs[k] = val
         data = buf.getbuffer()
         from .io.atomic import write_error
 

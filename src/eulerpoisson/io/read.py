@@ -22,12 +22,25 @@ sample, a slice, a whole chunk at a time (:meth:`LazyTrajectory.iter_chunks`)
 for any selection (``lazy[a:b]``, :meth:`LazyTrajectory.load`).
 The plots (:mod:`eulerpoisson.viz.plots`) draw it chunk by chunk, decimated
 to the resolution of the picture, in bounded memory.
+
+Reading fast. Decoding the chunks is what a long picture costs (a
+:math:`10^8`-sample store holds 2.4 GB of Ω). zarr's synchronous reads go
+through one event loop and hold the GIL for about as long as Zstandard
+takes, so they do not get faster with threads; the chunks of the layout we
+write are therefore read from their files and decoded by numcodecs directly
+(:class:`_DirectChunks`, bit for bit what zarr reads; anything else goes
+through zarr), by several threads at once (:meth:`LazyTrajectory.map_arrays`,
+:func:`ordered_map`, :func:`read_workers` threads), each reading into
+buffers of its own that it reuses piece after piece (fresh memory costs a
+page fault per 4 kB, which adds up to a third of the decoding). Only the
+variables asked for are read; equally spaced times are computed, not read.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -143,6 +156,202 @@ def _time_grid(attrs, T: int, first: float, last: float):
     return g
 
 
+# ---------------------------------------------------------------------------
+# reading chunks without zarr's machinery (the layout we write)
+# ---------------------------------------------------------------------------
+class _NotDirect(Exception):
+    """The direct reader cannot read this chunk (zarr reads it instead)."""
+
+
+def _zstd_content_size(raw) -> int | None:
+    """The decompressed size recorded in a single Zstandard frame's header (RFC 8878 §3.1.1), or None."""
+    if len(raw) < 6 or bytes(raw[:4]) != b"\x28\xb5\x2f\xfd":
+        return None
+    fhd = raw[4]
+    fcs_flag, single, dict_flag = fhd >> 6, (fhd >> 5) & 1, fhd & 3
+    pos = 5 + (0 if single else 1) + (0, 1, 2, 4)[dict_flag]
+    size = (1 if single else 0, 2, 4, 8)[fcs_flag]
+    if size == 0 or len(raw) < pos + size:
+        return None
+    value = int.from_bytes(bytes(raw[pos:pos + size]), "little")
+    return value + 256 if size == 2 else value
+
+
+_LOCAL = threading.local()
+
+
+def _thread_buffer(size: int) -> bytearray:
+    """This thread's reusable read buffer, at least ``size`` bytes (fresh memory costs a page fault per 4 kB)."""
+    buf = getattr(_LOCAL, "buf", None)
+    if buf is None or len(buf) < size:
+        buf = _LOCAL.buf = bytearray(max(size, 2 * len(buf) if buf is not None else size))
+    return buf
+
+
+class _DirectChunks:
+    """Whole chunks of a plain Zarr (format 3) array in a local folder, read and decoded without zarr.
+
+    zarr's synchronous reads go through one event loop and hold the GIL
+    for about as long as Zstandard takes to decode a chunk, so threads do
+    not read a long store faster. This reader opens the chunk files itself
+    and decodes them with numcodecs (which releases the GIL): several
+    threads decode in parallel. Only the layout eulerpoisson writes is read
+    this way — format 3, a regular grid split along time only, the codecs
+    ``bytes`` and optionally ``zstd``, no storage transformers, a local
+    folder (:meth:`of` gives None otherwise); a missing chunk file is the
+    fill value, as for zarr. A chunk it cannot decode raises
+    :class:`_NotDirect`, and the caller reads it through zarr.
+    """
+
+    def __init__(self, root: Path, arr, axis: int, dtype: np.dtype, compressed: bool):
+        self.root = root
+        self.key = arr.metadata.encode_chunk_key
+        self.axis = axis
+        self.shape = tuple(int(n) for n in arr.shape)
+        self.chunks = tuple(int(n) for n in arr.chunks)
+        self.c = self.chunks[axis]
+        self.dtype = dtype
+        self.native = dtype.newbyteorder("=")
+        self.compressed = compressed
+        self.fill = arr.fill_value
+        self.nbytes = int(np.prod(self.chunks)) * dtype.itemsize
+
+    @classmethod
+    def of(cls, arr, axis: int):
+        """The direct reader of ``arr`` (time along ``axis``), or None where zarr must read it."""
+        try:
+            from zarr.codecs import BytesCodec, ZstdCodec
+            from zarr.core.chunk_grids import RegularChunkGrid
+            from zarr.storage import LocalStore
+
+            md = arr.metadata
+            if getattr(md, "zarr_format", None) != 3 or not isinstance(arr.store, LocalStore):
+                return None
+            if not isinstance(md.chunk_grid, RegularChunkGrid) or tuple(getattr(md, "storage_transformers", ())):
+                return None
+            codecs = tuple(md.codecs)
+            if not 1 <= len(codecs) <= 2 or type(codecs[0]) is not BytesCodec:
+                return None
+            if len(codecs) == 2 and type(codecs[1]) is not ZstdCodec:
+                return None
+            dtype = np.dtype(arr.dtype)
+            if dtype.kind not in "fiu":
+                return None
+            endian = getattr(codecs[0].endian, "value", codecs[0].endian)
+            dtype = dtype.newbyteorder(">" if endian == "big" else "<")
+            shape, chunks = tuple(arr.shape), tuple(arr.chunks)
+            if len(shape) != len(chunks) or not 0 <= axis < len(shape) or not all(
+                    c == s for i, (c, s) in enumerate(zip(chunks, shape)) if i != axis) or chunks[axis] < 1:
+                return None
+            root = Path(str(arr.store.root)) / str(arr.path)
+            if not root.is_dir():
+                return None
+            return cls(root, arr, axis, dtype, len(codecs) == 2)
+        except Exception:  # noqa: BLE001 - any surprise: zarr reads it
+            return None
+
+    def _chunk(self, k: int, out: np.ndarray | None = None) -> np.ndarray:
+        """Chunk ``k`` (full chunk shape), decoded into ``out`` (C-contiguous, native) when given."""
+        coords = [0] * len(self.shape)
+        coords[self.axis] = k
+        fn = self.root.joinpath(*self.key(tuple(coords)).split("/"))
+        try:
+            with open(fn, "rb", buffering=0) as fh:
+                size = os.fstat(fh.fileno()).st_size
+                buf = _thread_buffer(size + 1)  # the file read into this thread's buffer: no fresh pages
+                got = fh.readinto(buf)
+            raw = memoryview(buf)[:got]
+            if got > size:  # the file grew meanwhile (a writer): not ours to read
+                raise _NotDirect(f"{fn} is being written")
+        except FileNotFoundError:  # never written: the fill value (NaN for an unfinished chunk)
+            if out is None:
+                out = np.empty(self.chunks, self.native)
+            out[...] = self.fill
+            return out
+        except OSError as exc:
+            raise _NotDirect(str(exc)) from exc
+        if self.compressed:
+            from numcodecs.zstd import decompress
+
+            try:
+                if (out is not None and self.dtype.isnative and out.flags.c_contiguous
+                        and _zstd_content_size(raw) == self.nbytes == out.nbytes):
+                    decompress(raw, out)
+                    return out
+                raw = memoryview(decompress(raw))
+            except Exception as exc:  # noqa: BLE001 - not what we wrote: zarr reads it (and says what is wrong)
+                raise _NotDirect(str(exc)) from exc
+        if raw.nbytes != self.nbytes:
+            raise _NotDirect(f"chunk {k} holds {raw.nbytes} bytes, expected {self.nbytes}")
+        x = np.frombuffer(raw, self.dtype).reshape(self.chunks)
+        if out is None:
+            return x.astype(self.native)  # a copy: the buffer is reused
+        out[...] = x
+        return out
+
+    def read(self, a: int, b: int, step: int = 1, out: np.ndarray | None = None) -> np.ndarray:
+        """Elements ``a:b:step`` along the time axis (``0 <= a``, ``b <= len``, ``step >= 1``).
+
+        Into ``out`` when it is an array of the result's shape and dtype (C-contiguous), else a new array.
+        """
+        ax, c = self.axis, self.c
+        idx = range(a, b, step)
+        n = len(idx)
+        shape = list(self.shape)
+        shape[ax] = n
+        if not (isinstance(out, np.ndarray) and out.shape == tuple(shape) and out.dtype == self.native
+                and out.flags.c_contiguous and out.flags.writeable):
+            out = np.empty(shape, self.native)
+        if n == 0:
+            return out
+        pos = 0
+        for k in range(idx[0] // c, idx[-1] // c + 1):
+            lo, hi = k * c, min((k + 1) * c, self.shape[ax])
+            i0 = max(a, lo)
+            i0 = a + -(-(i0 - a) // step) * step  # the first index of the range in this chunk
+            i1 = min(b, hi)
+            if i0 >= i1:
+                continue
+            m = len(range(i0, i1, step))
+            dst = [slice(None)] * len(shape)
+            dst[ax] = slice(pos, pos + m)
+            target = out[tuple(dst)]
+            if step == 1 and i0 == lo and i1 - lo == c and target.flags.c_contiguous:
+                self._chunk(k, target)  # straight into the result
+            else:
+                src = [slice(None)] * len(shape)
+                src[ax] = slice(i0 - lo, i1 - lo, step)
+                target[...] = self._chunk(k)[tuple(src)]
+            pos += m
+        return out
+
+
+_COUNT = np.zeros(0)  # 0, 1, 2, ... as float64 (numpy's float arange is several times slower than arithmetic)
+
+
+def _grid_times(grid, a: int, b: int, step: int, out: np.ndarray | None = None) -> np.ndarray:
+    """``grid[a:b:step]`` of a :class:`~eulerpoisson.io.stream.TimeGrid`, bit for bit, in a few in-place passes.
+
+    The sample indices are exact integers in float64, so ``index * step + t0``
+    is computed exactly as the grid does it.
+    """
+    global _COUNT
+    m = len(range(a, b, step)) if step >= 1 else 0
+    if grid.n == 1 or grid._step == 0 or step < 1 or b > 2**53:
+        return grid[a:b:step]
+    if _COUNT.size < m:
+        _COUNT = np.arange(max(m, 2 * _COUNT.size), dtype=np.float64)
+    if not (isinstance(out, np.ndarray) and out.shape == (m,) and out.dtype == np.float64 and out.flags.writeable):
+        out = None
+    y = np.multiply(_COUNT[:m], float(step), out=out)
+    y += a
+    y *= grid._step
+    y += grid.t0
+    if m and a + (m - 1) * step == grid.n - 1:
+        y[-1] = grid.t1
+    return y
+
+
 class StoredArray:
     """A time-dependent variable of a Zarr store, read on demand: shape ``(*batch, T, ...)``.
 
@@ -158,6 +367,7 @@ class StoredArray:
         self.dtype = np.dtype(arr.dtype)
         self.ndim = len(self.shape)
         self.chunks = tuple(getattr(arr, "chunks", shp))
+        self._direct = None  # the direct chunk reader (False: zarr reads everything)
 
     def __len__(self) -> int:
         return self.shape[0]
@@ -166,9 +376,25 @@ class StoredArray:
     def size(self) -> int:
         return int(np.prod(self.shape))
 
-    def read(self, a: int, b: int, step: int = 1) -> np.ndarray:
-        """Samples ``a:b:step`` along time, shape ``(*batch, n, ...)``."""
+    def read(self, a: int, b: int, step: int = 1, out: np.ndarray | None = None) -> np.ndarray:
+        """Samples ``a:b:step`` along time, shape ``(*batch, n, ...)``.
+
+        Whole chunks of the layout we write are read from their files and
+        decoded directly (:class:`_DirectChunks`, several threads may read at
+        once), into ``out`` when it is an array of the stored shape
+        ``(n, ...)`` (or ``(bodies, n, ...)``) and dtype; anything else through zarr.
+        """
         sl = slice(a, b, step)
+        axis = 1 if self._bshape else 0
+        if self._direct is None:
+            self._direct = _DirectChunks.of(self._arr, axis) or False
+        if self._direct and (step or 1) > 0:
+            try:
+                x = self._direct.read(*sl.indices(int(self._arr.shape[axis])), out=out)
+            except _NotDirect:
+                pass
+            else:
+                return x.reshape(self._bshape + x.shape[1:]) if self._bshape else x
         if self._bshape:
             x = np.asarray(self._arr[:, sl])
             return x.reshape(self._bshape + x.shape[1:])
@@ -187,6 +413,51 @@ class StoredArray:
 
     def __repr__(self) -> str:
         return f"StoredArray(shape={self.shape}, dtype={self.dtype})"
+
+
+def _all_finite(x: np.ndarray) -> bool:
+    """True when every value of ``x`` is finite (one pass: the sum is finite, else a check value by value)."""
+    with np.errstate(all="ignore"):
+        total = np.add.reduce(x, axis=None) if x.size else 0.0
+    return bool(np.isfinite(total)) or bool(np.all(np.isfinite(x)))
+
+
+def read_workers() -> int:
+    """Threads that read (and draw) a long store at once: the CPUs this process may use, 2 to 8."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # pragma: no cover - not Linux
+        n = os.cpu_count() or 1
+    return max(2, min(8, n))
+
+
+_END = object()
+
+
+def ordered_map(fn, items, workers: int | None = None):
+    """``fn(item)`` for every item, computed by ``workers`` threads, yielded in the order of ``items``.
+
+    At most ``workers + 1`` calls are in flight (bounded memory); an
+    exception of a call is raised where its result is yielded; what is not
+    yet started when the caller stops is cancelled.
+    """
+    import collections
+    from concurrent.futures import ThreadPoolExecutor
+
+    items = iter(items)
+    workers = read_workers() if workers is None else max(1, int(workers))
+    with ThreadPoolExecutor(workers, thread_name_prefix="eulerpoisson-read") as ex:
+        pending = collections.deque(ex.submit(fn, it) for _, it in zip(range(workers + 1), items))
+        try:
+            while pending:
+                res = pending.popleft().result()
+                nxt = next(items, _END)
+                if nxt is not _END:
+                    pending.append(ex.submit(fn, nxt))
+                yield res
+        finally:
+            for f in pending:
+                f.cancel()
 
 
 def _zarr_group(path: Path):
@@ -322,7 +593,10 @@ class LazyTrajectory:
         """A stored time-dependent variable (``"quaternion"``, ``"omega"``, ``"M"``, ``"m"``, ``"energy"``, ``"gibbs"``)."""
         if name not in self.variables:
             raise KeyError(f"{self.path} has no variable {name!r} (it has {', '.join(self.variables)})")
-        return StoredArray(self._group[name], self.batch_shape)
+        cache = self.__dict__.setdefault("_stored", {"quaternion": self.quaternion, "omega": self.omega})
+        if name not in cache:
+            cache[name] = StoredArray(self._group[name], self.batch_shape)
+        return cache[name]
 
     def _check_unit(self, q: np.ndarray, where: str) -> None:
         from ..attitude.core import UNIT_QUATERNION_TOLERANCE
@@ -360,25 +634,34 @@ class LazyTrajectory:
             )
         return Trajectory(t, q, w, self.body, self.method, self.options, self.stats, torque=list(self.model.torques))
 
-    def read_arrays(self, names, a: int = 0, b: int | None = None, step: int = 1) -> dict:
+    def read_arrays(self, names, a: int = 0, b: int | None = None, step: int = 1, *,
+                    scratch: dict | None = None) -> dict:
         """The raw arrays ``names`` (``"time"`` and stored variables) at samples ``a:b:step``, without a Trajectory.
 
         The cheapest way through a long store: only the named variables are
         read (a plot of Ω reads ``time`` and ``omega``, nothing else).
         Quaternions read are checked to be unit; any NaN (an unwritten sample
-        of a partial store) is an error.
+        of a partial store) is an error. With a dict ``scratch`` the arrays
+        are read into those it holds from an earlier call (same names and
+        shapes; fresh memory costs a page fault per 4 kB), and it keeps
+        the arrays read: the caller must be done with them before the next call.
         """
         a, b, step = slice(a, b, step).indices(self.T)
         out = {}
         for nm in names:
+            buf = None if scratch is None or self.batch_shape else scratch.get(nm)
             if nm == "time" and self._grid is not None:  # equally spaced times: computed, bit for bit those stored
-                out[nm] = self._grid[a:b:step]
+                out[nm] = _grid_times(self._grid, a, b, step, out=buf)
+                if scratch is not None:
+                    scratch[nm] = out[nm]
                 continue
             arr = self.t if nm == "time" else self.stored(nm)
-            x = arr.read(a, b, step)
+            x = arr.read(a, b, step, out=buf)
+            if scratch is not None and not self.batch_shape:
+                scratch[nm] = x
             if nm == "quaternion":
                 self._check_unit(x, f"samples {a}:{b}")
-            if nm != "gibbs" and not np.all(np.isfinite(x)):
+            if nm != "gibbs" and not _all_finite(x):
                 raise EulerPoissonError(
                     f"{self.path}: samples {a}:{b} of {nm} are not all written (NaN): an unfinished run? "
                     "resume it with the same 'simulate' command"
@@ -389,20 +672,30 @@ class LazyTrajectory:
     def iter_arrays(self, names, size: int | None = None, ranges=None):
         """:meth:`read_arrays` piece by piece (``size`` samples, whole Zarr chunks; or the given ``(a, b)`` ranges).
 
-        The next piece is read in a background thread while the caller works on the current one.
+        The next pieces are read in background threads while the caller works on the current one.
         """
-        from concurrent.futures import ThreadPoolExecutor
+        return self.map_arrays(names, None, size, ranges)
 
+    def map_arrays(self, names, fn=None, size: int | None = None, ranges=None, workers: int | None = None,
+                   reuse: bool = False):
+        """``fn(piece)`` for the pieces of :meth:`iter_arrays`, in order, each read and computed in a thread.
+
+        The chunks are decoded in parallel (numcodecs and NumPy release the
+        GIL): with ``workers`` threads (default :func:`read_workers`) at most
+        ``workers + 1`` pieces are in flight, so memory stays bounded by
+        the piece size. ``fn=None`` yields the pieces themselves. With
+        ``reuse=True`` (and an ``fn``) each thread reads its pieces into the
+        same arrays (``read_arrays(scratch=...)``): ``fn`` must not keep or
+        return them (a reduction of them, such as a min/max envelope, is fine).
+        """
         ranges = list(self.chunk_bounds(size) if ranges is None else ranges)
-        if not ranges:
-            return
-        with ThreadPoolExecutor(1) as ex:
-            nxt = ex.submit(self.read_arrays, names, *ranges[0])
-            for k in range(len(ranges)):
-                cur = nxt.result()
-                if k + 1 < len(ranges):
-                    nxt = ex.submit(self.read_arrays, names, *ranges[k + 1])
-                yield cur
+
+        def task(r):
+            scratch = _LOCAL.__dict__.setdefault("scratch", {}) if reuse and fn is not None else None
+            piece = self.read_arrays(names, *r, scratch=scratch)
+            return piece if fn is None else fn(piece)
+
+        return ordered_map(task, ranges, workers)
 
     def __getitem__(self, index):
         if isinstance(index, slice):

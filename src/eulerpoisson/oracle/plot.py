@@ -20,6 +20,8 @@ def plot_report(report, out=None, *, title: str | None = None):
     out : str or os.PathLike, optional
         Write the figure here (.png, .svg, .pdf).
     title : str, optional
+        Drawn as typed, as the labels and the run's source (a file name): a
+        ``$`` is a dollar sign, never mathtext.
 
     Returns
     -------
@@ -31,6 +33,7 @@ def plot_report(report, out=None, *, title: str | None = None):
         Without matplotlib (extra ``plot``).
     """
     from ..errors import require
+    from ..viz.plots import plain_text  # text, never mathtext
 
     require("matplotlib", "plot")
     from matplotlib import rcParams
@@ -42,6 +45,7 @@ def plot_report(report, out=None, *, title: str | None = None):
     colors = rcParams["axes.prop_cycle"].by_key()["color"]
     for n, (label, r) in enumerate(items):
         c = colors[n % len(colors)]
+        label = plain_text(label)
         ax1.semilogy(r.t, np.maximum(r.attitude_error, FLOOR), color=c, label=f"{label} (max {r.max_attitude_error:.2g} rad)")
         ax2.semilogy(r.t, np.maximum(r.energy_error, FLOOR), color=c, label=f"{label}: energy")
         ax2.semilogy(r.t, np.maximum(r.momentum_error, FLOOR), color=c, ls="--", label=f"{label}: |m - m0|/|m0|")
@@ -56,7 +60,7 @@ def plot_report(report, out=None, *, title: str | None = None):
     ax2.set_xlabel("t")
     ax1.legend(fontsize=8, loc="lower right")
     ax2.legend(fontsize=8, loc="lower right")
-    ax1.set_title(title or f"{items[0][1].source} against the exact motion")
+    ax1.set_title(plain_text(title or f"{items[0][1].source} against the exact motion"))
     if out is not None:
         fig.savefig(out, dpi=110)
     return fig

@@ -11,16 +11,36 @@ min → max and max → min, so that consecutive columns join — whose vertical
 extent over each column is exactly the range of the samples in it: the
 drawn envelope contains every sample's value, and nothing more than the
 samples reach.
+
+A piece is reduced on its own (:meth:`MinMaxEnvelope.reduce`: for monotonic
+times, a search for the column boundaries and one ``minimum`` and one
+``maximum`` pass per series, nothing copied) and merged afterwards
+(:meth:`MinMaxEnvelope.merge`, in any order): the pieces of a long run are
+reduced in several threads at once.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
-__all__ = ["MinMaxEnvelope", "DEFAULT_BINS"]
+__all__ = ["MinMaxEnvelope", "Piece", "DEFAULT_BINS"]
 
 #: columns of a decimated time series (a 7-inch figure at 150 dpi is about 1000 pixels wide)
 DEFAULT_BINS = 2000
+
+
+class Piece(NamedTuple):
+    """The extremes of one piece of samples per column reached (:meth:`MinMaxEnvelope.reduce`)."""
+
+    cols: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    count: np.ndarray
+    n: int
+    tmin: float
+    tmax: float
 
 
 class MinMaxEnvelope:
@@ -54,32 +74,121 @@ class MinMaxEnvelope:
         return np.clip(np.nan_to_num(b, nan=0.0), 0, self.nbins - 1).astype(np.int64)
 
     def add(self, t, y) -> None:
-        """Add samples: times ``t`` (n,) and values ``y`` (n, k) (or (n,) for one series)."""
-        t = np.asarray(t, dtype=float)
-        y = np.asarray(y, dtype=float).reshape(t.shape[0], self.k)
-        if t.size == 0:
-            return
-        b = self.bins_of(t)
-        d = np.diff(b)
-        if np.all(d <= 0) and not np.all(d == 0):  # decreasing times: reverse, then it is the monotonic case
-            b, y, d = b[::-1], y[::-1], -d[::-1]
-        if np.all(d >= 0):  # monotonic: every column is one contiguous run
-            starts = np.concatenate([[0], np.flatnonzero(d) + 1])
-            cols = b[starts]
+        """Add samples: times ``t`` (n,) and values ``y`` (n, k) (or (n,) for one series, or a list of k columns)."""
+        self.merge(self.reduce(t, y))
+
+    def reduce(self, t, y):
+        """The extremes of one piece of samples, for :meth:`merge`; reads nothing but ``t0``, ``t1``, ``nbins``.
+
+        Pieces can be reduced in several threads at once and merged in any
+        order. ``y`` is an array (n, k) or (n,) or a list of ``k`` arrays
+        (n,) (columns: any strides, nothing is copied). Times that are
+        monotonic (the usual case) cost a search for the column boundaries
+        (:meth:`_starts`) and one ``minimum``/``maximum`` pass per series;
+        times in any order are binned one by one.
+
+        Returns
+        -------
+        Piece
+            ``cols`` (m,) the columns reached, ``lo``/``hi`` (m, k) their
+            extremes (NaN samples ignored; NaN where a series has none),
+            ``count`` (m,), ``n`` samples, ``tmin``/``tmax``.
+        """
+        t = np.asarray(t, dtype=float).reshape(-1)
+        n = t.size
+        if isinstance(y, (list, tuple)):
+            cols = [np.asarray(c, dtype=float).reshape(n) for c in y]
+        else:
+            y = np.asarray(y, dtype=float).reshape(n, self.k)
+            cols = [y[:, j] for j in range(self.k)]
+        if len(cols) != self.k:
+            raise ValueError(f"expected {self.k} series, got {len(cols)}")
+        if n == 0:
+            e = np.empty((0, self.k))
+            return Piece(np.empty(0, np.int64), e, e, np.empty(0, np.int64), 0, np.inf, -np.inf)
+        if n == 1 or bool(np.all(t[1:] >= t[:-1])):
+            return self._reduce_sorted(t, cols, float(t[0]), float(t[-1]))
+        if bool(np.all(t[1:] <= t[:-1])):  # decreasing times: reversed (views), it is the monotonic case
+            return self._reduce_sorted(t[::-1], [c[::-1] for c in cols], float(t[-1]), float(t[0]))
+        b = self.bins_of(t)  # any order
+        lo = np.full((self.nbins, self.k), np.inf)
+        hi = np.full((self.nbins, self.k), -np.inf)
+        for j, yj in enumerate(cols):
+            ok = ~np.isnan(yj)
+            np.fmin.at(lo[:, j], b[ok], yj[ok])
+            np.fmax.at(hi[:, j], b[ok], yj[ok])
+        count = np.bincount(b, minlength=self.nbins)
+        used = np.flatnonzero(count)
+        empty = ~(lo[used] <= hi[used])
+        with np.errstate(invalid="ignore"):
+            return Piece(used, np.where(empty, np.nan, lo[used]), np.where(empty, np.nan, hi[used]), count[used], n,
+                         float(np.min(t)), float(np.max(t)))
+
+    def _starts(self, t) -> np.ndarray:
+        """First sample of every column reached by increasing times ``t``: where :meth:`bins_of` changes.
+
+        The column edges located by ``searchsorted`` are corrected sample by
+        sample against :meth:`bins_of` itself (rounding may put a sample next
+        to an edge into the neighbouring column), so that the columns are
+        exactly those of :meth:`bins_of`; a binary search if that does not settle.
+        """
+        n = t.size
+        b0, b1 = (int(v) for v in self.bins_of(t[[0, -1]]))
+        if b1 == b0:
+            return np.zeros(1, np.int64)
+        js = np.arange(b0 + 1, b1 + 1)
+        span = self.t1 - self.t0
+        pos = np.searchsorted(t, self.t0 + js * (span / self.nbins)) if span > 0 else np.full(js.size, n - 1)
+        pos = np.clip(pos, 1, n - 1)  # first index with bins_of >= j: t[0] is in b0 < j, t[-1] in b1 >= j
+        for _ in range(8):
+            up = self.bins_of(t[pos]) < js  # too early: move right
+            down = ~up & (self.bins_of(t[pos - 1]) >= js)  # too late: move left
+            if not (up.any() or down.any()):
+                break
+            pos = np.clip(pos + up - down, 1, n - 1)
+        else:
+            pos = self._starts_bisect(t, js)
+        return np.unique(np.concatenate([[0], pos]))  # columns without samples share their next one's start
+
+    def _starts_bisect(self, t, js) -> np.ndarray:
+        lo = np.zeros(js.size, np.int64)  # bins_of(t[lo]) < j <= bins_of(t[hi])  (bins_of is monotonic in t)
+        hi = np.full(js.size, t.size - 1, np.int64)
+        while True:
+            open_ = hi - lo > 1
+            if not open_.any():
+                return hi
+            mid = (lo + hi) // 2
+            ge = self.bins_of(t[mid]) >= js
+            hi = np.where(open_ & ge, mid, hi)
+            lo = np.where(open_ & ~ge, mid, lo)
+
+    def _reduce_sorted(self, t, cols, tmin, tmax):
+        n = t.size
+        starts = self._starts(t)
+        bins = self.bins_of(t[starts])
+        ends = np.append(starts[1:], n)
+        lo = np.empty((starts.size, self.k))
+        hi = np.empty((starts.size, self.k))
+        for j, yj in enumerate(cols):
+            lo[:, j] = np.minimum.reduceat(yj, starts)
+            hi[:, j] = np.maximum.reduceat(yj, starts)
+        bad = np.isnan(lo) | np.isnan(hi)
+        if bad.any():  # a column with NaN samples: their extremes without them (NaN when all are NaN)
             with np.errstate(invalid="ignore"):
-                mn = np.fmin.reduceat(y, starts, axis=0)
-                mx = np.fmax.reduceat(y, starts, axis=0)
-            self.lo[cols] = np.fmin(self.lo[cols], mn)
-            self.hi[cols] = np.fmax(self.hi[cols], mx)
-            self.count[cols] += np.diff(np.concatenate([starts, [b.size]]))
-        else:  # any order
-            for j in range(self.k):
-                yj = y[:, j]
-                ok = ~np.isnan(yj)
-                np.fmin.at(self.lo[:, j], b[ok], yj[ok])
-                np.fmax.at(self.hi[:, j], b[ok], yj[ok])
-            np.add.at(self.count, b, 1)
-        self.samples += t.size
+                for c, j in zip(*np.nonzero(bad)):
+                    seg = cols[j][starts[c]:ends[c]]
+                    lo[c, j] = np.fmin.reduce(seg)
+                    hi[c, j] = np.fmax.reduce(seg)
+        return Piece(bins, lo, hi, ends - starts, n, tmin, tmax)
+
+    def merge(self, piece) -> None:
+        """Add the extremes of a piece reduced by :meth:`reduce` (of this envelope, or one with the same columns)."""
+        c = piece.cols
+        if c.size:
+            self.lo[c] = np.fmin(self.lo[c], piece.lo)
+            self.hi[c] = np.fmax(self.hi[c], piece.hi)
+            self.count[c] += piece.count
+        self.samples += piece.n
 
     def points(self):
         """``(x, y)``: two points per non-empty column at its centre, ``x`` (2m,), ``y`` (2m, k).

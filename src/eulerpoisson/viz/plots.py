@@ -62,8 +62,8 @@ store longer than :data:`MAX_READ_3D` samples is read in whole chunks evenly
 spread over the run, so that a picture of :math:`10^8` samples costs what one
 of :math:`10^7` does. ``gibbs`` splits at most a million samples into charts
 (in linear time) and draws at most :data:`MAX_CHARTS` of them, evenly chosen.
-Names (of the body, of the method) are drawn as text, never as mathtext
-(:func:`plain_text`).
+Names (of the body, of the method) and the time unit are drawn as text, never
+as mathtext (:func:`plain_text`): a ``$`` in them is a dollar sign.
 
 The Gibbs-vector picture and chart restarts
 -------------------------------------------
@@ -93,6 +93,7 @@ J. E. Marsden and T. S. Ratiu, *Introduction to Mechanics and Symmetry*,
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -172,6 +173,11 @@ class _One:
     method: str
     time_unit: str
     label: str  # "name (I = a, b, c)"
+
+    @property
+    def unit(self) -> str:
+        """The time unit as matplotlib draws it literally (:func:`plain_text`: a ``$`` is no mathtext)."""
+        return plain_text(self.time_unit)
 
     @property
     def R(self):
@@ -347,7 +353,7 @@ def _setup_3d(ax, lim, labels, elev=22, azim=38):
 #: time series with more samples than this are drawn as min/max envelopes per pixel column
 DECIMATE_ABOVE = 20_000
 #: samples per piece when a long run is walked through (in memory or in a Zarr store)
-_PIECE = 1_000_000
+_PIECE = 200_000
 #: most samples a long run is thinned to before the Gibbs vector is split into charts
 _MAX_GIBBS_SAMPLES = 1_000_000
 #: most chart segments drawn by plot_gibbs (evenly chosen among all of them)
@@ -402,22 +408,37 @@ def _ends(traj, index) -> _One:
     return one
 
 
-def _body_pieces(traj, idx, names=("time", "quaternion", "omega"), size: int = _PIECE):
-    """Dicts of the arrays ``names`` of body ``idx``, piece by piece (bounded memory; a store reads only those)."""
+def _map_pieces(traj, idx, fn, names=("time", "quaternion", "omega"), size: int | None = None):
+    """``fn(piece)`` for the run of body ``idx``, piece by piece, in order; the pieces are computed in threads.
+
+    A piece is a dict of the arrays ``names`` of that body (a store reads
+    those only, its chunks decoded in parallel; a run in memory gives views).
+    Memory is bounded by a few pieces (:func:`~eulerpoisson.io.read.ordered_map`).
+    """
+    from ..io.read import ordered_map
+
+    size = _PIECE if size is None else size
     if _is_lazy(traj):
-        for piece in traj.iter_arrays(names, size):
-            yield {k: (v if k == "time" else v[idx]) for k, v in piece.items()}
+        def one(piece):
+            return fn({k: (v if k == "time" or not idx else v[idx]) for k, v in piece.items()})
+
+        yield from traj.map_arrays(names, one, size, reuse=True)  # fn reduces the piece: its memory is reused
         return
     q, w = traj.quaternion[idx], traj.omega[idx]
-    for a in range(0, len(traj.t), size):  # in memory: views, and the state only
-        yield {"time": traj.t[a:a + size], "quaternion": q[a:a + size], "omega": w[a:a + size]}
+
+    def view(a):  # in memory: views, and the state only
+        return fn({"time": traj.t[a:a + size], "quaternion": q[a:a + size], "omega": w[a:a + size]})
+
+    yield from ordered_map(view, range(0, len(traj.t), size))
 
 
 def _envelope(traj, index, k: int, values, nbins=None, names=("time", "quaternion", "omega")):
-    """Min/max envelope of ``values(piece, one) -> (n, k)`` over the run, computed piece by piece.
+    """Min/max envelope of ``values(piece, one)`` (an array (n, k) or ``k`` columns) over the run, piece by piece.
 
-    Returns ``(one, env)``: the body at the ends (:func:`_ends`) and the
-    :class:`~eulerpoisson.viz.decimate.MinMaxEnvelope`.
+    Every piece is read and reduced in a worker thread
+    (:meth:`MinMaxEnvelope.reduce <eulerpoisson.viz.decimate.MinMaxEnvelope.reduce>`);
+    this thread merges the extremes. Returns ``(one, env)``: the body at the
+    ends (:func:`_ends`) and the :class:`~eulerpoisson.viz.decimate.MinMaxEnvelope`.
     """
     from .decimate import DEFAULT_BINS, MinMaxEnvelope
 
@@ -427,10 +448,13 @@ def _envelope(traj, index, k: int, values, nbins=None, names=("time", "quaternio
     for _ in range(2):  # a store whose times are not monotonic: a second pass over the true range
         env = MinMaxEnvelope(t0, t1, k, nbins or DEFAULT_BINS)
         lo, hi = t0, t1
-        for piece in _body_pieces(traj, idx, names):
-            t = piece["time"]
-            lo, hi = min(lo, float(np.min(t))), max(hi, float(np.max(t)))
-            env.add(t, values(piece, one))
+
+        def reduce(piece, env=env):
+            return env.reduce(piece["time"], values(piece, one))
+
+        for part in _map_pieces(traj, idx, reduce, names):
+            lo, hi = min(lo, part.tmin), max(hi, part.tmax)
+            env.merge(part)
         if lo >= t0 and hi <= t1:
             break
         t0, t1 = lo, hi
@@ -484,7 +508,7 @@ def _thin(traj, limit: int, *, blocks: bool = False):
             if c0 < d:
                 ranges.append((c0, d, step))
                 pos += len(range(c0, d, step))
-    parts = [traj.read_arrays(("time", "quaternion", "omega"), *r) for r in ranges]
+    parts = list(traj.map_arrays(("time", "quaternion", "omega"), ranges=ranges))  # read in parallel threads
     if not parts:
         return (traj.load(), [0]) if blocks else traj.load()
     out = Trajectory(np.concatenate([p["time"] for p in parts]),
@@ -547,8 +571,8 @@ def plot_omega(traj, ax=None, fig=None, *, index=0, **style):
         if _is_long(traj):
             _decimated_note(ax, env.samples)
         ax.axhline(0.0, color="0.3", lw=0.6)
-        ax.set_xlabel(f"time t [{one.time_unit}]")
-        ax.set_ylabel(f"body angular velocity Ω [rad/{one.time_unit}]")
+        ax.set_xlabel(f"time t [{one.unit}]")
+        ax.set_ylabel(f"body angular velocity Ω [rad/{one.unit}]")
         ax.set_xlim(one.t[0], one.t[-1])
         ax.legend(loc="upper right", ncols=3)
         ax.set_title(_title(one, "Body angular velocity Ω(t)"))
@@ -581,7 +605,13 @@ def invariant_drift(one: _One) -> dict[str, np.ndarray]:
 
 
 def _drift_values(traj, index):
-    """``values(t, q, omega, one)`` of the five drift curves of :func:`invariant_drift`, for :func:`_envelope`."""
+    """``(values, names, scales)`` of the five drift curves of :func:`invariant_drift`, for :func:`_envelope`.
+
+    ``values(piece, one)`` gives the columns :math:`|x - x_0|` (E, the norm of m,
+    m1, m2, m3), not yet divided by their ``scales``: a positive division is
+    monotonic, so the extremes per column divided afterwards are those of the
+    drift, bit for bit, at a fraction of the cost.
+    """
     from ..trajectory import Trajectory
 
     first = traj[0] if _is_lazy(traj) else Trajectory(traj.t[:1], traj.quaternion[..., :1, :], traj.omega[..., :1, :],
@@ -592,9 +622,6 @@ def _drift_values(traj, index):
     m0 = ref.m[0]
     mn0 = float(np.linalg.norm(m0))
 
-    def rel(x, r, scale):
-        return np.abs(x - r) / (scale if scale > 0 else 1.0)
-
     # a store keeps m (and, for the free body, the energy): read those instead of computing them
     stored = set(getattr(traj, "variables", ()))
     use_m = _is_lazy(traj) and "m" in stored
@@ -602,6 +629,13 @@ def _drift_values(traj, index):
     names = ("time",) + (("m",) if use_m else ("quaternion",)) + (("energy",) if use_E else ("omega",))
 
     def values(piece, one):
+        n = piece["time"].shape[0]
+        cols = _thread_columns(5, n)  # this thread's arrays, reused piece after piece (no fresh pages)
+
+        def dist(x, r, out):
+            np.subtract(x, r, out=out)
+            return np.abs(out, out=out)
+
         if use_m:
             m = piece["m"]
         else:
@@ -614,15 +648,32 @@ def _drift_values(traj, index):
             M = w @ one.inertia.T
             E = 0.5 * (w[:, 0] * M[:, 0] + w[:, 1] * M[:, 1] + w[:, 2] * M[:, 2])
         m1, m2, m3 = m[:, 0], m[:, 1], m[:, 2]
-        mn = np.sqrt(m1 * m1 + m2 * m2 + m3 * m3)  # (a reduction over a short last axis is slow)
-        out = np.empty((m.shape[0], 5))
-        out[:, 0] = rel(E, E0, abs(E0))
-        out[:, 1] = rel(mn, mn0, mn0)
-        for i in range(3):
-            out[:, 2 + i] = rel(m[:, i], m0[i], mn0)
-        return out
+        mn, sq = cols[1], cols[2]
+        np.square(m1, out=mn)
+        mn += np.square(m2, out=sq)
+        mn += np.square(m3, out=sq)
+        np.sqrt(mn, out=mn)  # (a reduction over a short last axis is slow)
+        return [dist(E, E0, cols[0]), dist(mn, mn0, mn), dist(m1, m0[0], cols[2]), dist(m2, m0[1], cols[3]),
+                dist(m3, m0[2], cols[4])]
 
-    return values, names
+    scales = np.array([abs(E0), mn0, mn0, mn0, mn0])
+    return values, names, np.where(scales > 0, scales, 1.0)
+
+
+_LOCAL = threading.local()
+
+
+def _thread_columns(k: int, n: int) -> list[np.ndarray]:
+    """``k`` float64 arrays of length ``n``, this thread's own, reused from call to call.
+
+    For work on the pieces of a long run in worker threads: fresh memory
+    costs a page fault per 4 kB, more than the arithmetic done on it.
+    """
+    have = getattr(_LOCAL, "columns", [])
+    if len(have) < k or have[0].size < n:
+        size = max(n, have[0].size if have else 0)
+        have = _LOCAL.columns = [np.empty(size) for _ in range(max(k, len(have)))]
+    return [c[:n] for c in have[:k]]
 
 
 def _rotate(q, v):
@@ -659,8 +710,10 @@ def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
     """
     long = _is_long(traj)
     if long:
-        values, names = _drift_values(traj, index)
+        values, names, scales = _drift_values(traj, index)
         one, env = _envelope(traj, index, 5, values, names=names)
+        env.lo /= scales  # the extremes of |x - x0|, divided: those of the drift
+        env.hi /= scales
         x, y = env.points()
         curves = {key: y[:, i] for i, key in enumerate(("E", "|m|", "m₁", "m₂", "m₃"))}
     else:
@@ -685,7 +738,7 @@ def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
         top = max(float(np.nanmax([np.nanmax(y) for y in curves.values()])), 1e3 * eps)
         ax.set_ylim(eps / 4, top * 60)  # room for the legend above the curves
         ax.set_xlim(one.t[0], one.t[-1])
-        ax.set_xlabel(f"time t [{one.time_unit}]")
+        ax.set_xlabel(f"time t [{one.unit}]")
         ax.set_ylabel("relative drift [dimensionless]")
         ax.legend(loc="upper left", ncols=5, fontsize=8)
         ax.set_title(_title(one, "Drift of the integrals: |x(t) − x(t₀)| / scale"))
@@ -829,7 +882,7 @@ def plot_polhode(traj, ax=None, fig=None, *, index=0, family=4, **style):
     lim = 1.2 * (L if L > 0 else 1.0)
     with mpl.rc_context(STYLE):
         fig, ax = _new_axes(ax, fig, True, (6.2, 6.0))
-        unit = f"kg m²/{one.time_unit}"
+        unit = f"kg m²/{one.unit}"
         _setup_3d(ax, lim, [f"M{str(i + 1).translate(_SUB)} [{unit}]" for i in range(3)])
         if L > 0:
             _unit_sphere(ax, L, alpha=0.12)
@@ -1093,7 +1146,7 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
             ax.plot(*np.stack([-e, e]).T, color=AXIS_COLORS[i], lw=0.7, alpha=0.6)
         sm = mpl.cm.ScalarMappable(norm=norm, cmap=cmap)
         cb = fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.08)
-        cb.set_label(f"chart start time [{one.time_unit}]")
+        cb.set_label(f"chart start time [{one.unit}]")
         ax.legend(loc="upper left", fontsize=8)
         ax.set_title(_title(
             one, f"Gibbs vector n(t) = k tan(α/2) in local charts (restart at |n| = {_fmt(r)})"))
@@ -1305,7 +1358,7 @@ def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **
         ax.scatter([x[-1]], [y[-1]], color="k", marker="s", s=22, zorder=3, label="end")
         ax.scatter([0.0], [0.0], color="0.3", marker="+", s=60, zorder=2, label=f"up: {up_name}")
         cb = fig.colorbar(lc, ax=ax, shrink=0.8, pad=0.02)
-        cb.set_label(f"time t [{one.time_unit}]")
+        cb.set_label(f"time t [{one.unit}]")
         ax.set_xlim(-lim, lim)
         ax.set_ylim(-lim, lim)
         ax.set_aspect("equal")

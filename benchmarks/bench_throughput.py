@@ -1,4 +1,4 @@
-"""Throughput of the batched (vectorized) paths, one thread.
+"""Throughput of the batched (vectorized) paths: one thread, and all cores against one thread.
 
 * exact: evaluations per second for B bodies x T output times, attitude and angular velocity
   included, through ``solve`` and through the kernel ``_exact.exact_motion`` alone;
@@ -6,7 +6,13 @@
   of B bodies integrated to t_end, and the same for heyoka's batch (SIMD) mode when installed;
 * symplectic: body-steps per second for a batch of B bodies (splitting, splitting4, gauss4);
 * scipy's ``special.ellipj``: nanoseconds per evaluation, the cost of one Jacobi elliptic
-  function triple, as the yardstick of the exact method.
+  function triple, as the yardstick of the exact method;
+* threads (``solve(..., workers=)``): exact, taylor and symplectic (gauss4, the default scheme)
+  batches on one thread and on every usable core, and the speed-up. The two are timed alternately
+  (one thread, all cores, one thread, ...) and the best of each is kept, so that another process
+  that loads the machine for a while slows both alike.
+
+Every row but the threads rows runs with ``workers=1`` (one thread).
 
 The bodies: I = diag(1, 2, 3), identity attitude, Omega0 of random direction (fixed seed) with
 the length of the reference Omega0 = (1, 0.1, 0.5), so all regimes of the motion occur.
@@ -28,6 +34,29 @@ def bodies(n: int, seed: int = 20240601) -> np.ndarray:
     return v * np.linalg.norm(C.OMEGA0)
 
 
+def alternate_best(fns: dict, *, repeats: int, budget: float) -> dict:
+    """Best wall time of each callable of ``fns``, timed in turn (a, b, a, b, ...) after one warm-up call each.
+
+    Up to ``repeats`` rounds, fewer when a round would exceed ``budget`` seconds in total (at least two).
+    """
+    import time
+
+    for fn in fns.values():
+        fn()
+    best = {k: float("inf") for k in fns}
+    spent = 0.0
+    for r in range(repeats):
+        t_round = time.perf_counter()
+        for k, fn in fns.items():
+            t0 = time.perf_counter()
+            fn()
+            best[k] = min(best[k], time.perf_counter() - t0)
+        spent += time.perf_counter() - t_round
+        if r >= 1 and spent / (r + 1) * (r + 2) > budget:
+            break
+    return best
+
+
 def run(quick: bool = False, log=print) -> dict:
     from eulerpoisson.solvers.exact.motion import exact_motion
     from eulerpoisson.solvers import solve
@@ -41,6 +70,12 @@ def run(quick: bool = False, log=print) -> dict:
         "symplectic_steps": 10 if quick else 100,
         "symplectic_dt": 0.01,
         "ellipj_evaluations": 10_000 if quick else 1_000_000,
+        "threads_exact_bodies": 64 if quick else 1000,
+        "threads_exact_times": 20 if quick else 1000,
+        "threads_taylor_bodies": 64 if quick else 4000,
+        "threads_taylor_t_end": 2.0 if quick else 100.0,
+        "threads_symplectic_bodies": 64 if quick else 10_000,
+        "threads_symplectic_steps": 10 if quick else 500,
     }
     repeats = 1 if quick else 3
     I = list(C.INERTIA)
@@ -54,7 +89,7 @@ def run(quick: bool = False, log=print) -> dict:
     B, T = cfg["exact_bodies"], cfg["exact_times"]
     w0 = bodies(B)
     t = np.linspace(0.0, 100.0, T)
-    wall, tr, n = C.best_time(lambda: solve(I, t, omega0=w0, method="exact"), repeats=repeats, budget=20)
+    wall, tr, n = C.best_time(lambda: solve(I, t, omega0=w0, method="exact", workers=1), repeats=repeats, budget=20)
     add("exact_solve", f"exact via solve ({B} bodies x {T} times)", B * T / wall, "evaluations/s",
         us_per_evaluation=wall / (B * T) * 1e6, time_s=wall, timed_calls=n)
     M0 = w0 * np.asarray(C.INERTIA)
@@ -65,7 +100,7 @@ def run(quick: bool = False, log=print) -> dict:
     # taylor --------------------------------------------------------------------------
     B, te = cfg["taylor_bodies"], cfg["taylor_t_end"]
     w0 = bodies(B)
-    wall, tr, n = C.best_time(lambda: solve(I, [te], omega0=w0, method="taylor", tol=C.EPS),
+    wall, tr, n = C.best_time(lambda: solve(I, [te], omega0=w0, method="taylor", tol=C.EPS, workers=1),
                               repeats=repeats, budget=30)
     add("taylor_batch", f"taylor tol=eps batch ({B} bodies to t={te:g})", B * te / wall, "body-seconds/s",
         time_s=wall, timed_calls=n, steps=tr.stats.get("steps"))
@@ -84,11 +119,42 @@ def run(quick: bool = False, log=print) -> dict:
     w0 = bodies(B)
     for scheme, extra in (("splitting", {}), ("splitting4", {}), ("gauss4", {"variables": "quaternion"})):
         wall, tr, n = C.best_time(
-            lambda: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt, **extra),
+            lambda: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt, workers=1, **extra),
             repeats=repeats, budget=30)
         steps = int(tr.stats["steps"])
         add(f"symplectic_{scheme}", f"symplectic {scheme} batch ({B} bodies x {steps} steps)", B * steps / wall,
             "body-steps/s", time_s=wall, timed_calls=n)
+
+    # threads: one against every core -------------------------------------------------------
+    from eulerpoisson.solvers.parallel import available_cores
+
+    cores = available_cores()
+    out["cores"] = cores
+    Be, Te = cfg["threads_exact_bodies"], cfg["threads_exact_times"]
+    Bt, tt = cfg["threads_taylor_bodies"], cfg["threads_taylor_t_end"]
+    Bs, nsteps = cfg["threads_symplectic_bodies"], cfg["threads_symplectic_steps"]
+    hs = cfg["symplectic_dt"]
+    we, wt, ws = bodies(Be), bodies(Bt), bodies(Bs)
+    te_grid = np.linspace(0.0, 100.0, Te)
+    jobs = {
+        "exact": (lambda k: solve(I, te_grid, omega0=we, method="exact", workers=k),
+                  f"exact ({Be} bodies x {Te} times)", lambda tr: Be * Te, "evaluations/s"),
+        "taylor": (lambda k: solve(I, [tt], omega0=wt, method="taylor", tol=C.EPS, workers=k),
+                   f"taylor tol=eps ({Bt} bodies to t={tt:g})", lambda tr: Bt * tt, "body-seconds/s"),
+        "symplectic": (lambda k: solve(I, [nsteps * hs], omega0=ws, method="symplectic", dt=hs, workers=k),
+                       f"symplectic gauss4 ({Bs} bodies x {nsteps} steps)", lambda tr: Bs * int(tr.stats["steps"]),
+                       "body-steps/s"),
+    }
+    for name, (fn, what, count, unit) in jobs.items():
+        trial = fn(cores)
+        threads, amount = trial.stats["threads"], count(trial)
+        best = alternate_best({1: lambda: fn(1), cores: lambda: fn(cores)}, repeats=2 if quick else 15,
+                              budget=2.0 if quick else 30.0)
+        add(f"threads_{name}_1", f"{what}, 1 thread", amount / best[1], unit, time_s=best[1], workers=1)
+        add(f"threads_{name}_all", f"{what}, workers={cores} (threads: {threads})", amount / best[cores], unit,
+            time_s=best[cores], workers=cores, threads=threads)
+        add(f"threads_{name}_speedup", f"{name}: speed-up on {cores} cores (best of alternating runs)",
+            best[1] / best[cores], "x", cores=cores, threads=threads)
 
     # scipy ellipj yardstick ------------------------------------------------------------
     from scipy.special import ellipj

@@ -10,7 +10,8 @@ summary when present):
 ``long_run``
     to t = 1e5: time, energy error and attitude error: ``long_run.json``;
 ``throughput``
-    batched evaluation and integration rates: ``throughput.json``;
+    batched evaluation and integration rates, and the speed-up of exact, taylor and symplectic
+    batches on every usable core against one thread (``solve(..., workers=)``): ``throughput.json``;
 ``torque``
     bodies under torque: taylor step cost with gravity against the free body, the exact Lagrange top
     per evaluation, the exact splitting's rate, accuracy of taylor and rk on a heavy top:
@@ -21,8 +22,9 @@ summary when present):
 
 ``summary.md`` gathers the tables, the ratios against the peers measured in the same run and a
 PASS/MISS column for each goal of the issue, with the machine and the command. Every
-measurement uses one thread. ``--quick`` runs a tiny configuration (seconds; for the smoke test,
-not representative). When the full run writes to the default directory, the results block of
+measurement uses one thread (``EULERPOISSON_WORKERS=1`` unless set), except the threads rows of
+the throughput benchmark, which pass ``workers=`` explicitly. ``--quick`` runs a tiny
+configuration (seconds; for the smoke test, not representative). When the full run writes to the default directory, the results block of
 benchmarks/README.md is refreshed too (``--no-readme`` to skip).
 
 Peers: scipy (always), heyoka and MuJoCo when importable (``pip install heyoka mujoco``).
@@ -37,7 +39,7 @@ from __future__ import annotations
 import os
 
 for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS"):
+             "VECLIB_MAXIMUM_THREADS", "EULERPOISSON_WORKERS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
@@ -175,6 +177,24 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None) -> list[dict]:
     else:
         goals.append({"goal": "symplectic: at least 1e7 body-steps per second per core in batch",
                       "target": ">= 1e7 body-steps/s"})
+
+    # threads: every core against one
+    g = {"goal": "batches use all cores: exact, taylor and symplectic scale to >= 0.8 x the number of cores "
+                 "(bitwise identical results for any number of workers)",
+         "target": ">= 1.6x on 2 cores / >= 0.8 x cores (the slowest of the three)"}
+    names = ("exact", "taylor", "symplectic")
+    rows = {name: _row(tp["rows"], f"threads_{name}_speedup") for name in names} if tp else {}
+    if rows and all(rows.values()):
+        cores = int(next(iter(rows.values()))["cores"])
+        need = 0.8 * cores
+        worst = min(r["value"] for r in rows.values())
+        g["measured"] = (f"{cores} cores: " + ", ".join(f"{n} {r['value']:.2f}x" for n, r in rows.items())
+                         + " (best of alternating runs, one thread vs all)")
+        g["ratio"] = worst / need if cores > 1 else None
+        g["status"] = _status(worst >= need) if cores > 1 else "N/A"
+        if cores == 1:
+            g["measured"] += "; one usable core: nothing to scale"
+    goals.append(g)
     for g in goals:
         g.setdefault("measured", "not run")
         g.setdefault("ratio", None)
@@ -227,7 +247,8 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=Non
     L.append(f"- software: Python {machine['python']}, numpy {machine['numpy']}, scipy {machine['scipy']}, "
              f"numba {machine['numba']}, eulerpoisson {machine['eulerpoisson']}, heyoka {machine['heyoka'] or 'not installed'}, "
              f"MuJoCo {machine['mujoco'] or 'not installed'}; peers measured: {', '.join(machine.get('peers', []))}")
-    L.append("- every measurement on one thread; times are the best of several calls after a warm-up call, "
+    L.append("- every measurement on one thread except the threads rows (one thread against every core); "
+             "times are the best of several calls after a warm-up call, "
              "compilation (numba, heyoka's LLVM, MuJoCo's model) not timed (details in benchmarks/README.md); "
              "goals are ratios against peers of the same run")
     L.append("")
@@ -277,7 +298,7 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=Non
             L.append(f"\n- {n}")
     if tp:
         L.append("")
-        L.append("## Throughput (one thread)")
+        L.append("## Throughput (one thread; the threads rows: one thread and every core)")
         L.append("")
         L.append("| what | rate | unit |")
         L.append("|---|---|---|")

@@ -36,6 +36,51 @@ CONVENTIONS = (
 )
 
 
+def _unit_continuous(t: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Quaternions (..., T, 4) as a trajectory stores them: normalized, with signs continuous in time.
+
+    Body by body along the time axis (``t``, any order): any split of a batch gives the same bits.
+
+    Raises
+    ------
+    InvalidInputError
+        A zero quaternion.
+    """
+    # a fixed summation order (an einsum or a reduction may sum in an order that depends on the
+    # memory layout, and then two equal arrays could be normalized differently)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
+    if np.any(nrm == 0):
+        raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
+    # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
+    off = np.abs(nrm - 1.0) > 4 * np.finfo(float).eps
+    if np.any(off):
+        q = np.where(off, q / nrm, q)
+    if t.size < 2 or np.all(t[1:] >= t[:-1]):  # the usual case: no reordering needed
+        return quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
+    order = np.argsort(t, kind="stable")
+    qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
+    inv = np.empty_like(order)
+    inv[order] = np.arange(order.size)
+    return np.take(qs, inv, axis=-2)
+
+
+def _stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
+    """What :class:`Trajectory` does to a solver's output, for part of a batch (the solve driver runs it in the
+    thread that solved the part): ``quaternion`` and ``omega`` checked (finite, shapes), the quaternions
+    returned as the trajectory stores them (:func:`_unit_continuous`).
+
+    Raises
+    ------
+    InvalidInputError
+        As :class:`Trajectory` (the driver then builds the trajectory of the whole batch again, so that the
+        message is about the whole batch).
+    """
+    q = as_float_array(quaternion, "quaternion", (4,))
+    as_float_array(omega, "omega", (3,))
+    return _unit_continuous(t, q)
+
+
 class Trajectory:
     r"""Motion of one body or a batch of bodies at a set of output times.
 
@@ -83,7 +128,9 @@ class Trajectory:
     """
 
     def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None, *,
-                 torque=None):
+                 torque=None, _prepared: bool = False):
+        # _prepared (private, for the solve driver): ``quaternion`` and ``omega`` are float64 arrays already
+        # checked and stored by :func:`_stored_attitudes` (chunk by chunk, in the threads that solved them)
         self.t = as_float_array(t, "t")
         if self.t.ndim != 1:
             raise InvalidInputError(f"t must be a 1-D array of output times, shape (T,); got shape {self.t.shape}")
@@ -94,16 +141,16 @@ class Trajectory:
         for nm, val in (("options", options), ("stats", stats)):
             if val is not None and not isinstance(val, Mapping):
                 raise TypeError(f"{nm} must be a dict (or None), got {type(val).__name__} {val!r}")
-        q = as_float_array(quaternion, "quaternion", (4,))
-        self.omega = as_float_array(omega, "omega", (3,))
+        if _prepared:
+            q = np.asarray(quaternion, dtype=np.float64)
+            self.omega = np.asarray(omega, dtype=np.float64)
+        else:
+            q = as_float_array(quaternion, "quaternion", (4,))
+            self.omega = as_float_array(omega, "omega", (3,))
         if q.shape[-2:-1] != self.t.shape or self.omega.shape[:-1] != q.shape[:-1]:
             raise InvalidInputError(
                 f"inconsistent trajectory shapes: t {self.t.shape}, quaternion {q.shape}, omega {self.omega.shape}"
             )
-        # a fixed summation order (an einsum or a reduction may sum in an order that depends on the
-        # memory layout, and then two equal arrays could be normalized differently)
-        w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-        nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
         bshape = q.shape[:-2]
         try:
             ok = np.broadcast_shapes(body.batch_shape, bshape) == bshape
@@ -114,20 +161,7 @@ class Trajectory:
                 f"the body's batch shape {body.batch_shape} does not broadcast to the trajectory's batch "
                 f"shape {bshape} (quaternion {q.shape}, omega {self.omega.shape})"
             )
-        if np.any(nrm == 0):
-            raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
-        # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
-        off = np.abs(nrm - 1.0) > 4 * np.finfo(float).eps
-        if np.any(off):
-            q = np.where(off, q / nrm, q)
-        if self.t.size < 2 or np.all(self.t[1:] >= self.t[:-1]):  # the usual case: no reordering needed
-            self.quaternion = quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
-        else:
-            order = np.argsort(self.t, kind="stable")
-            qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
-            inv = np.empty_like(order)
-            inv[order] = np.arange(order.size)
-            self.quaternion = np.take(qs, inv, axis=-2)
+        self.quaternion = q if _prepared else _unit_continuous(self.t, q)
         self.body = body
         self.model = Model(body, torque)
         if self.model.batch_shape != () and np.broadcast_shapes(self.model.batch_shape, bshape) != bshape:

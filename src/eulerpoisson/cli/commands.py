@@ -143,6 +143,7 @@ _TOML_KINDS = {
     "output": {"file": "str", "json": "bool"},
     "torque": {"gravity": "numbers", "mass": "number", "center_of_mass": "numbers", "gravity_gradient": "number",
                "body_torque": "numbers", "space_torque": "numbers"},
+    "compute": {"workers": "int"},
 }
 _TOML_KEYS = {sec: set(keys) for sec, keys in _TOML_KINDS.items()}
 
@@ -246,6 +247,7 @@ _FLAGS = {
     "torque.gravity_gradient": "--gravity-gradient",
     "torque.body_torque": "--body-torque",
     "torque.space_torque": "--space-torque",
+    "compute.workers": "--workers",
 }
 
 
@@ -542,7 +544,7 @@ def cmd_simulate(args) -> int:
         *((opt, f"method.{opt}") for opt in METHOD_OPTIONS), ("out", "output.file"),
         ("gravity", "torque.gravity"), ("mass", "torque.mass"), ("com", "torque.center_of_mass"),
         ("gravity_gradient", "torque.gravity_gradient"), ("body_torque", "torque.body_torque"),
-        ("space_torque", "torque.space_torque"),
+        ("space_torque", "torque.space_torque"), ("workers", "compute.workers"),
     ) if getattr(args, attr, None) is not None}
     # two flags that say the same thing differently are an error; a flag replaces what the file says
     if "initial.omega" in given and "initial.m" in given:
@@ -627,6 +629,16 @@ def cmd_simulate(args) -> int:
         raise UsageError(f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}")
     check_supported(method, model)  # UnsupportedModelError (one line, exit 2) names the methods that can
     opts = _method_options(cfg, name, method)
+    workers = cfg.get("compute.workers")
+    if workers is not None:
+        try:
+            workers = int(str(workers).strip())
+        except ValueError:
+            workers = 0
+        if workers < 1:
+            raise UsageError(f"{name('compute.workers')} must be a whole number of threads >= 1, "
+                             f"got {cfg['compute.workers']!r}")
+        opts["workers"] = workers  # a keyword of solve, solve_from and solve_to_file, not a method option
     out = cfg.get("output.file")
     _check_file_name(out, name("output.file"))
     as_json = bool(args.json or cfg.get("output.json", False))
@@ -1198,6 +1210,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="print the state at T, the torques, the integrals at T and their drift as one JSON object")
     s.add_argument("--overwrite", action="store_true",
                    help="replace an existing output of the same kind (an interrupted .zarr run resumes without it)")
+    s.add_argument("-j", "--workers", metavar="N",
+                   help="threads that solve a batch of bodies (default: $EULERPOISSON_WORKERS, else every core; "
+                        "1: one thread); the results do not depend on it")
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=cmd_simulate)
 
@@ -1259,7 +1274,9 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("config", help="TOML file describing the sweep (see examples/sweep.toml)")
     sw.add_argument("--out", help="Zarr store (default: [output] path of the file)")
     sw.add_argument("--scheduler", help="'local' (default, an embedded cluster), 'serial', or tcp://HOST:PORT")
-    sw.add_argument("--workers", type=int, help="workers of the local cluster")
+    sw.add_argument("-j", "--workers", type=int, metavar="N",
+                    help="worker processes of the local cluster, or threads with --scheduler serial "
+                         "(default: [compute] workers, else every core); the results do not depend on it")
     sw.add_argument("--overwrite", action="store_true", help="replace a store made with another configuration")
     sw.add_argument("--quiet", action="store_true")
     sw.set_defaults(func=cmd_sweep)

@@ -453,7 +453,7 @@ def _shifted_torques(torques, t_start: float):
     return out, phi
 
 
-def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, **options):
+def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, workers=None, **options):
     r"""Continue a motion from its state at ``t_start`` to the (absolute) output times ``t``.
 
     The building block of long runs solved chunk by chunk: the model is
@@ -473,6 +473,8 @@ def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, *
         Time of the state ``(q_start, omega_start)``.
     q_start, omega_start : array_like, shapes (..., 4) and (..., 3)
     method : str
+    workers : int or None
+        Threads for a batch, as for :func:`~eulerpoisson.solve`.
     **options
         Method options.
 
@@ -491,7 +493,8 @@ def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, *
     t = np.asarray(t, dtype=float)
     t_start = float(t_start)
     if model.is_autonomous or t_start == 0.0:
-        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, **options)
+        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, workers=workers,
+                   **options)
         tr.t = t
         return tr
     torques, phi = _shifted_torques(model.torques, t_start)
@@ -501,7 +504,7 @@ def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, *
         rz = _rotation_z(phi)
         q_start = qmul(rz * np.array([1.0, -1.0, -1.0, -1.0]), q_start)
     tr = solve(Model(model.body, torques), t - t_start, omega0=omega_start, attitude0=q_start, method=method,
-               **options)
+               workers=workers, **options)
     q = tr.quaternion
     if turned:
         q = qmul(_rotation_z(phi)[..., None, :], q)
@@ -550,6 +553,7 @@ def solve_to_file(
     resume: bool = False,
     overwrite: bool = False,
     variables=None,
+    workers=None,
     **options,
 ) -> Path:
     r"""Solve the motion at very many output times and stream it to a Zarr store.
@@ -594,6 +598,10 @@ def solve_to_file(
         Time-dependent variables to write, a subset of :data:`TIME_VARIABLES`
         (default: all); ``quaternion`` and ``omega`` (the state) are always
         written.
+    workers : int or None
+        Threads that solve a batch of bodies, as for :func:`~eulerpoisson.solve`
+        (None: ``EULERPOISSON_WORKERS`` or every core); the results do not
+        depend on it, so a run may be resumed with another value.
     **options
         Method options (``tol``, ``dt``, ...).
 
@@ -633,6 +641,7 @@ def solve_to_file(
     """
     from ..util.validate import as_scalar
     from ..solvers import get_method, make_problem, solve
+    from ..solvers.parallel import check_workers
     from ..solvers.registry import check_supported
     from ..trajectory import Trajectory
 
@@ -658,6 +667,7 @@ def solve_to_file(
 
     cls = get_method(method)
     meth = cls(**options)  # validates the options
+    check_workers(workers)
     closed_form = cls.order is None
     src = _as_time_source(t)
     n = len(src)
@@ -792,9 +802,10 @@ def solve_to_file(
                     _check_monotonic(tc, prev_t, a, direction)
                 start = _time.perf_counter()
                 if closed_form or prev_q is None:
-                    tr = solve(model, tc, omega0=problem.omega0, attitude0=problem.q0, method=method, **options)
+                    tr = solve(model, tc, omega0=problem.omega0, attitude0=problem.q0, method=method,
+                               workers=workers, **options)
                 else:
-                    tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, **options)
+                    tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, workers=workers, **options)
                 q = tr.quaternion
                 if prev_q is not None:
                     # keep the quaternion sign continuous across the chunk boundary
@@ -808,7 +819,8 @@ def solve_to_file(
                         arr[tslice(a, b)] = _flatten_batch(data[name], bshape)
                     tarr[a:b] = tc
                 counters = {key: val for key, val in tr.stats.items()
-                            if isinstance(val, numbers.Number) and not isinstance(val, bool) and key != "wall_time"}
+                            if isinstance(val, numbers.Number) and not isinstance(val, bool)
+                            and key not in ("wall_time", "threads")}
                 _mark_done(work, k, {"wall_time": wall, "stats": counters,
                                      "written": datetime.now(timezone.utc).isoformat()})
                 prev_q = q[..., -1, :]

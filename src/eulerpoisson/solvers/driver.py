@@ -19,13 +19,15 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..trajectory import Trajectory
+from .parallel import check_workers, solve_batch
 from .problem import make_problem
 from .registry import MethodOptions, check_supported, get_method
 
 __all__ = ["solve"]
 
 
-def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None, method="exact", **options):
+def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None, method="exact", workers=None,
+          **options):
     r"""Motion of rigid bodies, free or under torque, at the output times ``t``.
 
     Parameters
@@ -60,23 +62,38 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=
         a method's typed options (``TaylorOptions(tol=1e-12)``,
         ``SymplecticOptions(scheme="gauss6", dt=0.01)``, ...), which name
         their method.
+    workers : int or None
+        Threads that solve a batch of bodies: chunks of the batch are solved
+        in parallel by the compiled kernels (:mod:`~eulerpoisson.solvers.parallel`).
+        None (default): the environment variable ``EULERPOISSON_WORKERS``
+        if set, else every core this process may use; 1: the calling thread
+        only. The results are the same, bit for bit, for every value. Small
+        problems (fewer than 32 bodies, or less than about 10 ms of work)
+        always run on the calling thread, and so does ``method="rk"``
+        (scipy's integrators hold the GIL).
     **options
         Method options (e.g. ``tol`` or ``dt``); unknown ones raise TypeError.
 
     Returns
     -------
     Trajectory
-        Times, attitudes, angular velocities and integrals.
+        Times, attitudes, angular velocities and integrals. ``stats`` holds
+        the method's counters (over the whole batch: totals such as
+        ``steps`` summed over the chunks of a threaded solve, maxima such
+        as ``steps_max`` taken over them), ``wall_time`` (seconds from the
+        start of the solution to the finished trajectory) and ``threads``
+        (the threads that solved the batch).
 
     Raises
     ------
     TypeError
         Neither or both of ``omega0``/``m0``; both ``attitude0`` and
-        ``gibbs0``; an unknown keyword (named as an argument of ``solve``
-        when no method has it, with the closest name) or an option of
-        another method.
+        ``gibbs0``; ``workers`` not an integer; an unknown keyword (named
+        as an argument of ``solve`` when no method has it, with the closest
+        name) or an option of another method.
     InvalidInputError
-        Unknown method, bad shapes, NaN/inf, a non-unit quaternion.
+        Unknown method, bad shapes, NaN/inf, a non-unit quaternion,
+        ``workers`` < 1 (or an invalid ``EULERPOISSON_WORKERS``).
     UnsupportedModelError
         The method cannot run the model (e.g. ``method="exact"`` with a
         gravity gradient); the message names the methods that can.
@@ -94,6 +111,7 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=
     >>> tr.omega.shape
     (2, 3)
     """
+    check_workers(workers)
     if isinstance(method, MethodOptions):
         cls = get_method(method.method)
         _check_keywords(cls, options)
@@ -115,10 +133,8 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=
     if not cls.negative_times and np.any(problem.t < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
     start = _time.perf_counter()
-    res = m.run(problem)
-    wall = _time.perf_counter() - start
-    stats = {"wall_time": wall, **res.stats}
-    return Trajectory(
+    res = solve_batch(m, problem, workers)
+    tr = Trajectory(
         t=problem.t,
         quaternion=res.q,
         omega=res.omega,
@@ -126,14 +142,19 @@ def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=
         torque=problem.model.torques,
         method=method,
         options=dict(m.config),
-        stats=stats,
+        stats={"wall_time": 0.0, **res.stats},
+        _prepared=res.prepared,
     )
+    # the solution and the trajectory's own work on it (normalization, sign continuity), which a threaded
+    # solve does in its threads
+    tr.stats["wall_time"] = _time.perf_counter() - start
+    return tr
 
 
 
 
 #: the keyword arguments of :func:`solve` itself
-_SOLVE_ARGUMENTS = ("omega0", "m0", "attitude0", "gibbs0", "torque", "method")
+_SOLVE_ARGUMENTS = ("omega0", "m0", "attitude0", "gibbs0", "torque", "method", "workers")
 
 
 def _check_keywords(cls, options) -> None:

@@ -43,11 +43,17 @@ class MethodResult:
     omega : ndarray, shape (*batch_shape, T, 3)
     stats : dict
         Method-specific counters (steps, function evaluations, chart changes...).
+    prepared : bool
+        Set by the driver (:mod:`.parallel`), never by a method: ``q`` and
+        ``omega`` were checked and ``q`` stored as a
+        :class:`~eulerpoisson.trajectory.Trajectory` stores it, chunk by
+        chunk, in the threads that solved them.
     """
 
     q: np.ndarray
     omega: np.ndarray
     stats: dict = field(default_factory=dict)
+    prepared: bool = False
 
 
 @dataclass(frozen=True)
@@ -132,6 +138,15 @@ class Method:
         the registry-driven convergence test.
     negative_times : bool
         Whether the method accepts t < 0 (time reversal).
+    threads : bool
+        Whether :func:`~eulerpoisson.solve` may split a batch into chunks of
+        bodies solved in threads (``workers=``, :mod:`.parallel`): the bodies
+        must be independent and the compiled code must release the GIL.
+    additive_stats : tuple of str
+        The ``stats`` that count over the bodies (e.g. the total number of
+        steps): added over the chunks of a batch solved in threads; every
+        other number is the largest over the chunks (a per-body maximum or a
+        value that every chunk shares), every other value the first chunk's.
 
     Attributes
     ----------
@@ -148,6 +163,8 @@ class Method:
     refine: ClassVar[str | None] = None
     negative_times: ClassVar[bool] = True
     description: ClassVar[str] = ""
+    threads: ClassVar[bool] = True
+    additive_stats: ClassVar[tuple[str, ...]] = ("evaluations",)
 
     def __init__(self, options: MethodOptions | None = None, /, **kwargs):
         if options is not None:
@@ -168,6 +185,28 @@ class Method:
 
     def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
         raise NotImplementedError
+
+    def for_batch(self, problem: Problem) -> "Method":
+        """This method with every choice that depends on the whole batch made on ``problem``.
+
+        Before a batch is split into chunks solved in threads (:mod:`.parallel`),
+        the driver calls this on the whole problem and runs the returned
+        method on every chunk: whatever a method decides from the batch as a
+        whole (a default step from the fastest body, a kernel chosen by the
+        number of bodies) must be decided here, once, so that every body gets
+        the same bits whatever the chunks. The default (no such choice):
+        ``self``.
+        """
+        return self
+
+    def work_estimate(self, problem: Problem) -> float:
+        """Rough seconds that ``problem`` takes on one core (decides whether threads pay off).
+
+        The default (the closed form's costs): half a microsecond per body
+        and per (body, output time).
+        """
+        B = int(np.prod(problem.batch_shape, dtype=int))
+        return 0.5e-6 * B * (1 + problem.t.shape[0])
 
     @classmethod
     def supports(cls, model: Model) -> str | None:

@@ -507,7 +507,7 @@ def _rotation_angle(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(np.linalg.norm(v, axis=-1), np.abs(w))
 
 
-def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = "exact") -> dict:
+def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = "exact", workers=None) -> dict:
     r"""Flip half-period, :math:`k^2`, attitude sensitivity and status of a batch of points.
 
     Parameters
@@ -523,6 +523,9 @@ def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = 
         Perturbation angle of the momentum direction (radians).
     method : str
         Method used to compute the attitudes at ``T``.
+    workers : int or None
+        Threads of the solve, as for :func:`~eulerpoisson.solve` (the
+        results do not depend on it).
 
     Returns
     -------
@@ -590,17 +593,20 @@ def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = 
         Ms = np.concatenate([Mv, Lv[:, None] * (c * u + s * e_th), Lv[:, None] * (c * u + s * e_ph)])
         Is = np.concatenate([Iv, Iv, Iv])
         # full (diagonal) tensors: a (3, 3) array of moments would read as one tensor
-        tr = solve(RigidBody(Is[:, :, None] * np.eye(3)), [T], omega0=Ms / Is, method=method)
+        tr = solve(RigidBody(Is[:, :, None] * np.eye(3)), [T], omega0=Ms / Is, method=method, workers=workers)
         q = tr.quaternion[:, 0, :].reshape(3, ok.size, 4)
         ang = np.maximum(_rotation_angle(q[0], q[1]), _rotation_angle(q[0], q[2]))
         sens[ok] = ang / delta
     return {"half_period": half, "k2": k2, "sensitivity": sens, "status": status}
 
 
-def _compute_chunk(inertia, M0, T, delta, method):
-    """One task: ``compute_points`` plus its wall time (module-level, so Dask can ship it by reference)."""
+def _compute_chunk(inertia, M0, T, delta, method, workers=None):
+    """One task: ``compute_points`` plus its wall time (module-level, so Dask can ship it by reference).
+
+    ``workers``: threads of the solve; Dask tasks pass 1 (Dask's workers already use the cores).
+    """
     start = _time.perf_counter()
-    out = compute_points(inertia, M0, T=T, delta=delta, method=method)
+    out = compute_points(inertia, M0, T=T, delta=delta, method=method, workers=workers)
     out["seconds"] = _time.perf_counter() - start
     return out
 
@@ -720,8 +726,10 @@ def run_sweep(
         ``"serial"`` (no Dask) or ``"tcp://HOST:PORT"`` (an existing
         cluster); default ``[compute] scheduler``.
     workers : int, optional
-        Worker processes of the local cluster; default ``[compute] workers``
-        or the CPU count.
+        Worker processes of the local cluster (each solves with one
+        thread), or threads of the ``"serial"`` scheduler (``solve(...,
+        workers=)``); default ``[compute] workers``, else the CPU count. The
+        results do not depend on it.
     client : distributed.Client, optional
         Use this client (overrides ``scheduler``).
     progress : None, bool or callable
@@ -859,7 +867,7 @@ def run_sweep(
             if todo and client is None and scheduler == "serial":
                 for k in todo:
                     I, M = inputs(k)
-                    write(k, _compute_chunk(I, M, *args))
+                    write(k, _compute_chunk(I, M, *args, workers))
                     n_done += bounds(k)[1] - bounds(k)[0]
                     bar.update(n_done)
             elif todo:
@@ -902,7 +910,7 @@ def _run_distributed(client, scheduler, workers, todo, inputs, write, args, boun
             if k is None:
                 return None
             I, M = inputs(k)
-            fut = client.submit(_compute_chunk, I, M, *args, pure=False)
+            fut = client.submit(_compute_chunk, I, M, *args, 1, pure=False)
             keys[fut.key] = k
             return fut
 

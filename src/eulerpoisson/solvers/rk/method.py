@@ -178,6 +178,11 @@ class RK(Method):
 
     :meth:`nominal_order` is the order of the chosen integrator (the highest
     order for the variable-order BDF and LSODA).
+
+    One thread: ``solve(..., workers=)`` does not split ``rk`` batches into
+    threads (``threads = False``), since ``solve_ivp`` steps in Python and
+    holds the GIL (threads would only add overhead); use processes (e.g.
+    ``eulerpoisson sweep``) to spread many bodies over cores.
     """
 
     name = "rk"
@@ -186,6 +191,8 @@ class RK(Method):
     refine = "tol"
     negative_times = True
     description = "scipy solve_ivp (DOP853 by default) on (q, Omega) or (n, Omega) with charts"
+    threads = False
+    additive_stats = ("nfev", "njev", "steps", "chart_changes")
 
     def nominal_order(self) -> int:
         """Order of the configured scipy integrator."""

@@ -74,7 +74,11 @@ Speed
     core); ``EULERPOISSON_NO_NUMBA=1`` selects the NumPy code below, which
     performs the same floating-point operations in the same order and gives
     the same results bit for bit. ``stats["compiled"]`` says which ran. The
-    Gauss methods in Gibbs variables (charts) always use NumPy.
+    Gauss methods in Gibbs variables (charts) always use NumPy. Large
+    batches are split over threads by ``solve(..., workers=)``; the default
+    step, taken from the fastest body, is fixed once for the whole batch
+    (:meth:`Symplectic.for_batch`), so the results do not depend on the
+    number of threads.
 
 References
 ----------
@@ -555,6 +559,79 @@ class Symplectic(Method):
     refine = "dt"
     negative_times = True
     description = "Gauss-Legendre collocation in (n, pi) with chart changes, or Lie-Poisson splitting in (R, M)"
+    additive_stats = ("chart_changes",)
+    #: the default step of a whole batch, fixed by :meth:`for_batch` (None: from the bodies run)
+    _batch_dt: float | None = None
+
+    def _scheme(self, problem: Problem) -> str:
+        return self.config["scheme"] or ("gauss4" if problem.model.is_free else "exact_splitting4")
+
+    def for_batch(self, problem: Problem) -> "Symplectic":
+        """This method with the default step (from the fastest body of the batch) fixed for the whole batch."""
+        import copy
+
+        planned = copy.copy(self)
+        if self.config["dt"] is None and problem.batch_shape and int(np.prod(problem.batch_shape)) > 0:
+            if self._scheme(problem) in TORQUE_SCHEMES:
+                planned._batch_dt = self._torque_default_dt(problem)
+            elif problem.model.is_free:
+                planned._batch_dt = self._free_default_dt(self._free_state(problem)[1])
+        return planned
+
+    def work_estimate(self, problem: Problem) -> float:
+        """Rough seconds on one core: the number of fixed steps times a cost per body-step of the scheme."""
+        cfg = self.config
+        B = int(np.prod(problem.batch_shape, dtype=int))
+        T = problem.t.shape[0]
+        tmax = float(np.max(np.abs(problem.t))) if T else 0.0
+        dt = cfg["dt"]
+        if dt is None:
+            with np.errstate(over="ignore"):
+                wmax = float(np.max(np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1)))) if B else 0.0
+            dt = DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else max(tmax, 1.0)
+        scheme = self._scheme(problem)
+        if scheme in TORQUE_SCHEMES:
+            per_step = 1e-6
+        elif scheme.startswith("gauss"):
+            per_step = 0.3e-6 if cfg["variables"] == "quaternion" else 5e-6
+        else:
+            per_step = 0.1e-6
+        with np.errstate(over="ignore"):
+            steps = B * (1.0 + tmax / float(dt))
+        return steps * per_step + 1e-7 * B * T
+
+    @staticmethod
+    def _free_state(problem: Problem):
+        """``(q0, w0, moments, frame)`` of a free-body batch in the principal frame, (C, B) arrays (frame None:
+        the body frame is principal)."""
+        B = int(np.prod(problem.batch_shape, dtype=int))
+        q0 = np.ascontiguousarray(problem.q0.reshape(B, 4).T)
+        w0 = np.ascontiguousarray(problem.omega0.reshape(B, 3).T)
+        if problem.body.is_diagonal:  # the body frame is principal: no transformation (and no cost)
+            return q0, w0, np.ascontiguousarray(problem.principal_moments.reshape(B, 3).T), None
+        frame = ch.principal_frame(problem)
+        q0, w0 = frame.to_principal(q0, w0)
+        return q0, w0, frame.moments, frame
+
+    @staticmethod
+    def _free_default_dt(w0) -> float:
+        """0.05 rad per step for the fastest body (``w0``: (3, B) principal-frame angular velocities)."""
+        with np.errstate(over="ignore"):
+            wmax = float(np.max(np.sqrt(ch.dot(w0, w0)))) if w0.shape[1] else 0.0
+        return DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
+
+    @staticmethod
+    def _torque_default_dt(problem: Problem) -> float:
+        """0.05 rad per step for the fastest body, its rate including the torque's sqrt(|I^-1 tau|) at t = 0."""
+        B = int(np.prod(problem.batch_shape, dtype=int))
+        w0 = problem.omega0.reshape(B, 3)
+        rate = np.sqrt(np.sum(w0 * w0, axis=-1))
+        if B and not problem.model.is_free:
+            tau = problem.model.torque(0.0, problem.q0, problem.omega0).reshape(B, 3)
+            acc = np.einsum("bij,bj->bi", np.linalg.inv(problem.inertia.reshape(B, 3, 3)), tau)
+            rate = np.maximum(rate, np.sqrt(np.sqrt(np.sum(acc * acc, axis=-1))))
+        wmax = float(np.max(rate)) if B else 0.0
+        return DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
 
     def nominal_order(self) -> int:
         """Order of convergence of the configured scheme (2, 4 or 6; 4 for the default)."""
@@ -574,7 +651,7 @@ class Symplectic(Method):
         from . import kernels as _k
 
         cfg = self.config
-        scheme = cfg["scheme"] or ("gauss4" if problem.model.is_free else "exact_splitting4")
+        scheme = self._scheme(problem)
         if scheme in TORQUE_SCHEMES:
             return self._run_exact_splitting(problem, SCHEMES[scheme], scheme)
         if not problem.model.is_free:
@@ -584,21 +661,11 @@ class Symplectic(Method):
             )
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
-        q0 = np.ascontiguousarray(problem.q0.reshape(B, 4).T)
-        w0 = np.ascontiguousarray(problem.omega0.reshape(B, 3).T)
-        if problem.body.is_diagonal:  # the body frame is principal: no transformation (and no cost)
-            frame = None
-            moments = np.ascontiguousarray(problem.principal_moments.reshape(B, 3).T)
-        else:
-            frame = ch.principal_frame(problem)
-            q0, w0 = frame.to_principal(q0, w0)
-            moments = frame.moments
+        q0, w0, moments, frame = self._free_state(problem)
         inv_m = 1.0 / moments
         dt = cfg["dt"]
         if dt is None:
-            with np.errstate(over="ignore"):
-                wmax = float(np.max(np.sqrt(ch.dot(w0, w0)))) if B else 0.0
-            dt = DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
+            dt = self._batch_dt if self._batch_dt is not None else self._free_default_dt(w0)
         dt = float(dt)
         if B:
             ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
@@ -754,13 +821,7 @@ class Symplectic(Method):
         data = problem.model.polynomial().flatten(bshape).in_frame(P)
         dt = cfg["dt"]
         if dt is None:
-            rate = np.sqrt(np.sum(w0 * w0, axis=-1))
-            if B and not problem.model.is_free:
-                tau = problem.model.torque(0.0, problem.q0, problem.omega0).reshape(B, 3)
-                acc = np.einsum("bij,bj->bi", np.linalg.inv(problem.inertia.reshape(B, 3, 3)), tau)
-                rate = np.maximum(rate, np.sqrt(np.sqrt(np.sum(acc * acc, axis=-1))))
-            wmax = float(np.max(rate)) if B else 0.0
-            dt = DEFAULT_ROTATION_PER_STEP / wmax if wmax > 0 else math.inf
+            dt = self._batch_dt if self._batch_dt is not None else self._torque_default_dt(problem)
         dt = float(dt)
         if B:
             ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],

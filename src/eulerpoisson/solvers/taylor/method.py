@@ -335,6 +335,7 @@ def integrate_principal(
     max_steps=1_000_000,
     chart_threshold=1.0,
     backend="auto",
+    lanes=None,
 ):
     r"""Taylor integration of bodies given in their principal frames.
 
@@ -369,6 +370,12 @@ def integrate_principal(
         ``"auto"``: compiled kernels for float64 when numba is in use
         (see :data:`~eulerpoisson.solvers.taylor.kernels.USE_NUMBA`),
         else the vectorized NumPy path (the only one for other arithmetic).
+    lanes : bool or None
+        Compiled backend: True runs the SIMD-lane kernel (16 bodies in
+        lockstep), False the one-body kernel; None (default) the lane kernel
+        for batches of ``LANES_MIN_BODIES`` (5) bodies or more. The two agree
+        to round-off; :meth:`Taylor.for_batch` fixes the choice for a whole
+        batch so that its chunks, solved in threads, give the same bits.
 
     Returns
     -------
@@ -437,7 +444,7 @@ def integrate_principal(
             raise InvalidInputError(f"moments must be > 0, got {m.tolist()}")
     kw = dict(tol=tol, order=order, dt=dt, max_steps=max_steps, threshold=chart_threshold)
     if use_numba:
-        q, om, st = _k.integrate_numba(m2, w2, q2, ta, **kw)
+        q, om, st = _k.integrate_numba(m2, w2, q2, ta, lanes=lanes, **kw)
     else:
         q, om, st = _k.integrate_numpy(m2, w2, q2, ta, **kw)
     status = st[:, 2]
@@ -508,8 +515,12 @@ class Taylor(Method):
     available (``EULERPOISSON_NO_NUMBA=1`` forces the NumPy path, same
     results to round-off); batches of 5 bodies or more run 16 bodies in
     lockstep in SIMD lanes (about 3x the throughput of one body after the
-    other, 1.3e6 body-seconds per second per core at tol = eps). See the
-    module docstring for the algorithm.
+    other, 1.3e6 body-seconds per second per core at tol = eps). Large
+    batches are split over threads by ``solve(..., workers=)`` (compiled
+    float64 kernels only: long double, mpmath and the NumPy fallback run on
+    one thread), with the kernel chosen once for the whole batch
+    (:meth:`for_batch`), so the results do not depend on the number of
+    threads. See the module docstring for the algorithm.
 
     Parameters
     ----------
@@ -569,6 +580,43 @@ class Taylor(Method):
     refine = "dt"
     negative_times = True
     description = "Lie series (eq. 1.23.1) as an adaptive high-order Taylor integrator"
+    additive_stats = ("steps", "chart_changes")
+    #: the kernel chosen for a whole batch by :meth:`for_batch` (None: by the size of the batch run)
+    _lanes: bool | None = None
+
+    @property
+    def threads(self) -> bool:
+        """Batches are solved in threads by the compiled (numba) kernels in float64.
+
+        Not in long double or mpmath, nor by the NumPy fallback: it holds
+        the GIL most of the time, and its Cauchy sums round differently when
+        a single body is left to step (NumPy sums a lone column pairwise), so
+        a body's last bits would depend on the chunk it is in.
+        """
+        return self.config["precision"] == "float64" and bool(_k.USE_NUMBA)
+
+    def for_batch(self, problem: Problem) -> "Taylor":
+        """This method with the free-body kernel (SIMD lanes or one body at a time) chosen for the whole batch."""
+        import copy
+
+        planned = copy.copy(self)
+        planned._lanes = int(np.prod(problem.batch_shape, dtype=int)) >= _k.LANES_MIN_BODIES
+        return planned
+
+    def work_estimate(self, problem: Problem) -> float:
+        """Rough seconds on one core: steps from the rotation angle (about 0.4 rad per step at tol = eps)."""
+        c = self.config
+        B = int(np.prod(problem.batch_shape, dtype=int))
+        T = problem.t.shape[0]
+        tmax = float(np.max(np.abs(problem.t))) if T else 0.0
+        if c["dt"] is not None:
+            steps = B * (1.0 + tmax / float(c["dt"]))
+        else:
+            with np.errstate(over="ignore"):
+                rate = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1))
+                steps = float(np.sum(1.0 + 2.5 * rate * tmax))
+        free = problem.model.is_free
+        return B * (1e-6 if free else 1e-5) + steps * (0.4e-6 if free else 1.5e-6) + 1e-7 * B * T
 
     @classmethod
     def supports(cls, model) -> str | None:
@@ -598,7 +646,7 @@ class Taylor(Method):
             qref0 = qmul(q0, qP)
         q, om, stats = integrate_principal(
             moments, w0p, problem.t, q0=qref0, tol=c["tol"], order=c["order"], dt=c["dt"],
-            max_steps=c["max_steps"], chart_threshold=c["chart_threshold"],
+            max_steps=c["max_steps"], chart_threshold=c["chart_threshold"], lanes=self._lanes,
         )
         if not diagonal:
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])

@@ -16,6 +16,9 @@ summary when present):
     bodies under torque: taylor step cost with gravity against the free body, the exact Lagrange top
     per evaluation, the exact splitting's rate, accuracy of taylor and rk on a heavy top:
     ``torque.json``;
+``exact``
+    the closed form's speed: distinct bodies each at one time (Monte-Carlo) and one body at many
+    times, through ``solve`` and the kernel, with the elliptic work counted: ``exact.json``;
 ``fit``
     spin-state estimation (``ep.fit``) from the default starts: 100 observations (diagonal and full
     inertia) and 10^4 observations: ``fit.json``.
@@ -55,7 +58,7 @@ if str(HERE) not in sys.path:
 import _common as C  # noqa: E402
 
 DEFAULT_OUT = HERE / "results"
-BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit")
+BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit", "exact")
 README = HERE / "README.md"
 README_START = "<!-- results:start -->"
 README_END = "<!-- results:end -->"
@@ -92,7 +95,7 @@ def _status(ok):
     return "PASS" if ok else "MISS"
 
 
-def evaluate_goals(wp, lr, tp, tq=None, ft=None) -> list[dict]:
+def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None) -> list[dict]:
     """One row per goal of the issue: target, measured value(s), ratio to the peer, PASS/MISS/N/A."""
     goals = []
 
@@ -222,6 +225,18 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None) -> list[dict]:
                  "target": f"<= {limit:g} s", "measured": f"{r['value']:.3g} s, worst |z| {r['worst_z']:.2f}",
                  "ratio": r["value"] / limit, "status": _status(r["value"] <= limit)}
             goals.append(g)
+    if exact:
+        # the closed form: distinct bodies at one time each, one body at many times (bench_exact.py)
+        r, k = _row(exact["rows"], "exact_montecarlo"), _row(exact["rows"], "exact_montecarlo_kernel")
+        goals.append({"goal": "exact: distinct bodies each at one time (Monte-Carlo), with the attitude",
+                      "target": ">= 2e6 evaluations/s per core",
+                      "measured": f"{r['value']:.3g}/s via solve ({r['us_per_evaluation']:.2f} us per body); "
+                                  f"kernel alone {k['value']:.3g}/s",
+                      "ratio": r["value"] / 2e6, "status": _status(r["value"] >= 2e6)})
+        r, k = _row(exact["rows"], "exact_many_times"), _row(exact["rows"], "exact_many_times_kernel")
+        goals.append({"goal": "exact: one body at many times", "target": "<= 0.3 us per evaluation",
+                      "measured": f"{r['value']:.3g} us via solve; kernel alone {k['value']:.3g} us",
+                      "ratio": r["value"] / 0.3, "status": _status(r["value"] <= 0.3)})
     return goals
 
 
@@ -232,7 +247,7 @@ def _fmt_ratio(r):
     return "" if r is None else f"{r:.3g}"
 
 
-def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=None) -> str:
+def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=None, exact=None) -> str:
     L = []
     L.append("# Benchmark summary")
     L.append("")
@@ -328,6 +343,18 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=Non
         for r in ft["rows"]:
             L.append(f"| {r['label']} | {r['value']:.3g} | {r['starts']} | {r['optima']} | {r['reduced_chi2']:.3f} "
                      f"| {r['worst_z']:.2f} |")
+    if exact:
+        L.append("")
+        L.append("## The exact method: Monte-Carlo and many times (one thread)")
+        L.append("")
+        L.append("| what | value | unit |")
+        L.append("|---|---|---|")
+        for r in exact["rows"]:
+            if "counts" in r:
+                work = ", ".join(f"{k} {v:.3g}" for k, v in r["counts"].items())
+                L.append(f"| {r['label']} | {work} | per {r['unit'].split(' per ')[-1]} |")
+            else:
+                L.append(f"| {r['label']} | {r['value']:.3g} | {r['unit']} |")
     L.append("")
     L.append("## Reference points quoted by the issue (2-core machine, not measured here)")
     L.append("")
@@ -398,19 +425,19 @@ def main(argv=None) -> int:
         elif path.exists():
             results[name] = json.loads(path.read_text())
     machine["load_average_at_end"] = C.load_average()
-    wp, lr, tp, tq, ft = (results.get(n) for n in BENCHMARKS)
+    wp, lr, tp, tq, ft, exact = (results.get(n) for n in BENCHMARKS)
     if args.summary_only:
         # describe the machine and command of the runs that produced the JSON, not of this call
-        runs = [r for r in (wp, lr, tp, tq, ft) if r]
+        runs = [r for r in (wp, lr, tp, tq, ft, exact) if r]
         if runs:
             machine, command = dict(runs[0]["machine"]), runs[0]["command"]
             ends = [r["machine"].get("load_average_at_end") for r in runs]
             machine["load_average_at_end"] = max((e for e in ends if e is not None), default=None)
             args.quick = bool(runs[0].get("quick"))
-    goals = evaluate_goals(wp, lr, tp, tq, ft)
+    goals = evaluate_goals(wp, lr, tp, tq, ft, exact)
     C.write_json(out / "goals.json", C.envelope("goals", quick=args.quick, command=command, machine=machine,
                                                 goals=goals))
-    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq, ft)
+    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq, ft, exact)
     (out / "summary.md").write_text(summary)
     print(f"  -> {out / 'summary.md'}")
     for g in goals:

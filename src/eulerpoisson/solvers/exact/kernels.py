@@ -36,16 +36,28 @@ phase in one loop (:func:`_params`); the Jacobi functions at ``tau``,
 three ``R_J`` (at ``tau``, at ``tau0`` and the complete one) in one
 duplication loop (:func:`_rj3`).  Each interleaved iteration keeps its own
 stopping rule, so the results are those of the stand-alone algorithms, bit
-for bit.  The per-(body, time) cost is dominated by the ``R_J`` duplication
-(an ``atan`` per step) and the Landen ascent; the per-body one by the AGM.
+for bit.  The ``R_C`` terms of the ``R_J`` duplication use the series of
+``atan(t)/t`` for ``|e| <= 2**-5`` (``elliptic.rc1_series``; all steps but
+the first one or two).
+
+The small helpers are compiled with ``inline="always"``: a call from one
+compiled function to another is otherwise an indirect call, which LLVM can
+neither inline nor vectorize; square roots are the ``llvm.sqrt`` intrinsic
+(:func:`_sqrt`; numba's ``math.sqrt`` is a call to the C library's) and the
+power-of-two scaling reads and builds exponent bits (:func:`_exponent`,
+:func:`_pow2`) instead of calling numba's ``frexp``/``ldexp`` helpers; the
+same numbers in every case.
 
 Layout: :func:`body_setup` computes the per-body constants (sorting to
 ascending moments by a proper signed permutation, exact power-of-two scaling,
 regime, elliptic parameter, Landen chain, initial phase) into a float64 array
 ``cst`` (indices ``_C_*``, the Landen levels included);
 :func:`body_eval` evaluates ``M`` and the attitude quaternion at one time;
-:func:`motion_kernel` and :func:`constants_kernel` are the two compiled entry
-points (one signature each).
+:func:`motion_kernel` (which runs the lane kernel of
+:mod:`eulerpoisson.solvers.exact.lanes`: sixteen evaluations in lockstep,
+bitwise equal to :func:`motion_kernel_scalar`) and :func:`constants_kernel`
+are the two compiled entry points (one signature each); :func:`free_flow` is
+the kinetic step of the exact splitting methods.
 
 The compiled kernels are used when numba imports and the environment variable
 ``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
@@ -78,6 +90,7 @@ __all__ = [
     "body_setup",
     "body_eval",
     "motion_kernel",
+    "motion_kernel_scalar",
     "free_flow",
     "equilibrium_eval",
     "constants_kernel",
@@ -90,6 +103,8 @@ from ...numerics.doubledouble import quick_two_sum as _quick_two_sum
 from ...numerics.doubledouble import split as _split
 from ...numerics.doubledouble import two_prod as _two_prod
 from ...numerics.doubledouble import two_sum as _two_sum
+from ...numerics.elliptic import RC_SERIES_MAX as _RC_SERIES_MAX
+from ...numerics.elliptic import rc1_series as _rc1_series
 from ...numerics.quaternion import qmul_components as _qmul
 from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
@@ -212,7 +227,7 @@ def _dd_div_f(ah, al, bh, bl):
 
 
 def _dd_sqrt_f(ah, al):
-    x = math.sqrt(ah)
+    x = _sqrt(ah)
     if x > 0.0:
         p, e = _two_prod_f(x, x)
         corr = ((ah - p) - e + al) / (2.0 * x)
@@ -221,11 +236,28 @@ def _dd_sqrt_f(ah, al):
     return _quick_two_sum(x, corr)
 
 
+def _sqrt(x):
+    """Correctly rounded square root (compiled: the ``llvm.sqrt`` intrinsic, which vectorizes; numba's
+    ``math.sqrt`` is a call to the C library's ``sqrt``, which LLVM does not always turn into one)."""
+    return math.sqrt(x)
+
+
 def _pow2(k):
     """``2**k`` for ``-1022 <= k <= 1023`` (a normal number), else 0."""
     if -1022 <= k <= 1023:
         return math.ldexp(1.0, k)
     return 0.0
+
+
+def _exponent(x):
+    """``math.frexp(x)[1]`` for finite ``x != 0``."""
+    return math.frexp(x)[1]
+
+
+def _exponent_lane(x):
+    """``(math.frexp(x)[1], ok)`` for finite ``x != 0``; compiled without a call, ``ok`` false for a
+    subnormal ``x`` (whose body the lane kernel then sets up with the scalar code)."""
+    return math.frexp(x)[1], True
 
 
 def _ldexp(x, f, k):
@@ -255,19 +287,20 @@ def _rf_poly(a0, x0, y0, a, fac):
         + 3.0 * e3 * e3 / 104.0
         + e2 * e2 * e3 / 16.0
     )
-    return poly / math.sqrt(a)
+    return poly / _sqrt(a)
 
 
 def _rc1(e, sp, p, lam, d):
-    """``R_C(1, 1 + e)`` (``elliptic._rc1``); ``1 + e = 2 sqrt(p) (p + lam) / d``
-    is formed only where it is used (``e < 0``)."""
-    t = math.sqrt(abs(e))
+    """``R_C(1, 1 + e)`` (``elliptic._rc1``): the series for ``|e| <= 2**-5``,
+    else the closed forms; ``1 + e = 2 sqrt(p) (p + lam) / d`` is formed only
+    where it is used (``e < 0``)."""
+    if abs(e) <= _RC_SERIES_MAX:
+        return _rc1_series(e)
+    t = _sqrt(abs(e))
     if e > 0.0:
         return math.atan(t) / t
-    if e < 0.0:
-        y = 2.0 * sp * (p + lam) / d
-        return 0.5 * math.log1p(2.0 * t * (1.0 + t) / y) / t
-    return 1.0
+    y = 2.0 * sp * (p + lam) / d
+    return 0.5 * math.log1p(2.0 * t * (1.0 + t) / y) / t
 
 
 def _rj_init(x0, y0, z0, p0):
@@ -290,10 +323,10 @@ def _rj_init(x0, y0, z0, p0):
 
 def _rj_step(a, fac, x, y, z, p, acc, delta, sc):
     """One duplication step of ``R_J`` with its ``R_C`` term (``elliptic._rj_step``)."""
-    sx = math.sqrt(x)
-    sy = math.sqrt(y)
-    sz = math.sqrt(z)
-    sp = math.sqrt(p)
+    sx = _sqrt(x)
+    sy = _sqrt(y)
+    sz = _sqrt(z)
+    sp = _sqrt(p)
     lam = sx * sy + sy * sz + sz * sx
     d = (sp + sx) * (sp + sy) * (sp + sz)
     dd = d * sc
@@ -331,7 +364,7 @@ def _rj_finish(a0, x0, y0, z0, a, fac, acc):
         - 9.0 * e2 * e3 / 52.0
         + 3.0 * e5 / 26.0
     )
-    return fac * poly / (a * math.sqrt(a)) + 6.0 * acc
+    return fac * poly / (a * _sqrt(a)) + 6.0 * acc
 
 
 def _rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
@@ -388,7 +421,7 @@ def _params(m, m1, rx, ry, rz, do_rf, cst):
     of ``R_F`` (if ``do_rf``).  Returns the ``R_F`` value (0 if not
     ``do_rf``).
     """
-    kp = math.sqrt(m1)
+    kp = _sqrt(m1)
     sep = m1 == 0.0
     # AGM state: a = 1, b = sqrt(m1) (double-double, scaled against underflow)
     agm_on = not sep
@@ -434,7 +467,7 @@ def _params(m, m1, rx, ry, rz, do_rf, cst):
                 agm_on = False
         if lan_on:
             if it < MAX_LANDEN and pc > thr:
-                kq = math.sqrt(pc1)
+                kq = _sqrt(pc1)
                 den = (1.0 + kq) * (1.0 + kq)
                 sq = pc / den
                 pn1 = 4.0 * kq / den
@@ -447,9 +480,9 @@ def _params(m, m1, rx, ry, rz, do_rf, cst):
                 lan_on = False
         if rf_on:
             if rfac * rq >= abs(ra):
-                sx = math.sqrt(x)
-                sy = math.sqrt(y)
-                sz = math.sqrt(z)
+                sx = _sqrt(x)
+                sy = _sqrt(y)
+                sz = _sqrt(z)
                 lam = sx * sy + sy * sz + sz * sx
                 ra = 0.25 * (ra + lam)
                 rfac = 0.25 * rfac
@@ -520,7 +553,7 @@ def _real_level(s, c, y, sq, pc):
     """One Landen step up on the real axis, carrying ``y = 1 - cn``."""
     s2 = s * s
     ce = 1.0 - y if y < 0.5 else c
-    d = math.sqrt(ce * ce + pc * s2)
+    d = _sqrt(ce * ce + pc * s2)
     den = 1.0 + sq * s2
     s_new = (1.0 + sq) * s / den
     c_new = ce * d / den
@@ -537,26 +570,39 @@ def _imag_start(vn, dv):
 def _imag_level(sig, C, sq):
     """One Landen step up on the imaginary axis (Jacobi's imaginary transformation)."""
     s2 = sig * sig
-    D = math.sqrt(1.0 + (sq * sq) * s2)
+    D = _sqrt(1.0 + (sq * sq) * s2)
     den = 1.0 - sq * s2
     return (1.0 + sq) * sig / den, C * D / den
 
 
-def _finish(n, r, neg, v, s, c, sep, m, m1, kp):
-    """``dn``, sign, separatrix and quarter-period map: ``(sn, cn, dn, n, r, s, c, d)``."""
-    if sep:
-        s = math.tanh(v)
-        c = _sech(v)
-        d = c
-    else:
-        s2 = s * s
-        if m <= 0.5:
-            d = math.sqrt(1.0 - m * s2)
-        else:
-            d = math.sqrt(c * c + m1 * s2)
+def _dn(s, c, m, m1):
+    """``dn`` at the chain's top from ``s = sn``, ``c = cn`` (no cancellation)."""
+    s2 = s * s
+    if m <= 0.5:
+        return _sqrt(1.0 - m * s2)
+    return _sqrt(c * c + m1 * s2)
+
+
+def _mod2(n):
+    """Python's ``n % 2.0`` for an integer-valued ``n``, exactly, without ``fmod`` (lane loops vectorize)."""
+    return n - 2.0 * math.floor(0.5 * n)
+
+
+def _mod4(n):
+    """Python's ``n % 4.0`` for an integer-valued ``n`` (exact)."""
+    return n - 4.0 * math.floor(0.25 * n)
+
+
+def _mod8(n):
+    """Python's ``n % 8.0`` for an integer-valued ``n`` (exact)."""
+    return n - 8.0 * math.floor(0.125 * n)
+
+
+def _quadrant(n, r, neg, s, c, d, kp):
+    """Sign and quarter-period map of the values ``s, c, d`` at ``|r|``: ``(sn, cn, dn, n, r, s, c, d)``."""
     if neg:
         s = -s
-    q = n % 4.0
+    q = _mod4(n)
     if q == 1.0 or q == 3.0:
         sn = c / d
         cn = -(kp * s / d)
@@ -569,6 +615,17 @@ def _finish(n, r, neg, v, s, c, sep, m, m1, kp):
         sn = -sn
         cn = -cn
     return sn, cn, dn, n, r, s, c, d
+
+
+def _finish(n, r, neg, v, s, c, sep, m, m1, kp):
+    """``dn``, sign, separatrix and quarter-period map: ``(sn, cn, dn, n, r, s, c, d)``."""
+    if sep:
+        s = math.tanh(v)
+        c = _sech(v)
+        d = c
+    else:
+        d = _dn(s, c, m, m1)
+    return _quadrant(n, r, neg, s, c, d, kp)
 
 
 def _sncndn3(k, u1h, u1l, u2h, u2l, u3h, u3l, cst):
@@ -661,12 +718,12 @@ def _sncndn3(k, u1h, u1l, u2h, u2l, u3h, u3l, cst):
 # =============================================================================
 def _jtot_args(nu, omnu, n, s, c, d, kp):
     """Arguments of the ``R_J`` in ``J(nu; nK + r)``: ``(odd, S, S^2, C^2, D^2, p)``."""
-    odd = n % 2.0 == 1.0
+    odd = _mod2(n) == 1.0
     sa_ = abs(s)
     if odd:
-        S = c / d
-        C = kp * sa_ / d
-        Dd = kp / d
+        S = _dv(c, d)
+        C = _dv(kp * sa_, d)
+        Dd = _dv(kp, d)
     else:
         S = sa_
         C = c
@@ -739,16 +796,21 @@ def _get_jcd(cst):
 
 def _theta(cst, n, s, c):
     """Unwrapped azimuth ``n pi/2 + dtheta`` of ``M`` about the circled axis (``motion._theta``)."""
-    if n % 2.0 == 1.0:
-        dtheta = math.atan2(cst[_C_AC] * cst[_C_KP] * s, cst[_C_A2] * c)
+    return _theta_v(cst[_C_AC], cst[_C_KP], cst[_C_A2], n, s, c)
+
+
+def _theta_v(ac, kp, a2, n, s, c):
+    """:func:`_theta` from the constants ``A_c``, ``k'`` and ``A_2``."""
+    if _mod2(n) == 1.0:
+        dtheta = math.atan2(ac * kp * s, a2 * c)
     else:
-        dtheta = math.atan2(cst[_C_A2] * s, cst[_C_AC] * c)
-    return (n % 8.0) * _HALF_PI + dtheta
+        dtheta = math.atan2(a2 * s, ac * c)
+    return _mod8(n) * _HALF_PI + dtheta
 
 
 def _jsep(N, tau):
     """Separatrix ``J = (tau - atan(sqrt(N) tanh tau)/sqrt(N)) / (1 + N)``."""
-    rN = math.sqrt(N)
+    rN = _sqrt(N)
     tt = math.tanh(tau)
     z = rN * tt
     if z != 0.0:
@@ -758,20 +820,24 @@ def _jsep(N, tau):
     return (tau - at) / (1.0 + N)
 
 
+def _near_xadd(N, cadd, Pp, snd, cnd, dnd):
+    """The addition-theorem term ``-(1/C) atan(C Y/X)`` of :func:`_near` (``Pp = sn(tau) sn(tau0)``)."""
+    X = 1.0 + N * snd * snd + N * Pp * cnd * dnd
+    Y = -Pp * snd
+    z = cadd * Y / X
+    if z != 0.0:
+        atanc = math.atan(z) / z
+    else:
+        atanc = 1.0
+    return -(Y / X) * atanc
+
+
 def _near(cst, dh, dl, sn_tau, snd, cnd, dnd, n, r, s, c, d):
     """Increment ``J(tau) - J(tau0)`` (A) or ``G(tau) - G(tau0)`` (B) for
     ``|lambda t| <= K`` by Jacobi's addition theorem (``motion._near``);
     ``snd ... d``: the Jacobi functions at ``delta = lambda t = dh + dl``."""
     N = cst[_C_NADD]
-    Pp = sn_tau * cst[_C_SN0]
-    X = 1.0 + N * snd * snd + N * Pp * cnd * dnd
-    Y = -Pp * snd
-    z = cst[_C_CADD] * Y / X
-    if z != 0.0:
-        atanc = math.atan(z) / z
-    else:
-        atanc = 1.0
-    xadd = -(Y / X) * atanc
+    xadd = _near_xadd(N, cst[_C_CADD], sn_tau * cst[_C_SN0], snd, cnd, dnd)
     dlt = dh + dl
     caseB = cst[_C_CASEB] != 0.0
     g0 = cst[_C_G0]
@@ -837,7 +903,7 @@ def _far(cst, n, r, s, c, d):
 
 def _qmin(M1, M2, M3, caseB, sa):
     """Quaternion of the minimal rotation taking ``M/|M|`` to ``sa e_3`` (B) / ``sa e_1`` (A)."""
-    nrm = math.sqrt(M1 * M1 + M2 * M2 + M3 * M3)
+    nrm = _sqrt(M1 * M1 + M2 * M2 + M3 * M3)
     x = M1 / nrm
     y = M2 / nrm
     z = M3 / nrm
@@ -852,7 +918,7 @@ def _qmin(M1, M2, M3, caseB, sa):
         vy = sa * z
         vz = -sa * y
     w = 1.0 + ze
-    f = 1.0 / math.sqrt(2.0 * w)
+    f = 1.0 / _sqrt(2.0 * w)
     return w * f, vx * f, vy * f, vz * f
 
 
@@ -880,51 +946,55 @@ def body_setup(i0, i1, i2, m0, m1_, m2, cst):
         True for a relative equilibrium (only the sorting data of ``cst`` is
         filled then).
     """
-    # --- proper signed permutation to ascending moments (stable argsort) ---
-    v = (i0, i1, i2)
-    p0, p1, p2 = 0, 1, 2
-    if v[p1] < v[p0]:
-        p0, p1 = p1, p0
-    if v[p2] < v[p1]:
-        p1, p2 = p2, p1
-        if v[p1] < v[p0]:
-            p0, p1 = p1, p0
-    inv = (1 if p0 > p1 else 0) + (1 if p0 > p2 else 0) + (1 if p1 > p2 else 0)
-    s1 = -1.0 if inv % 2 == 1 else 1.0
-    mv = (m0, m1_, m2)
-    I1u = v[p0]
-    I2u = v[p1]
-    I3u = v[p2]
-    M1u = 1.0 * mv[p0]
-    M2u = s1 * mv[p1]
-    M3u = 1.0 * mv[p2]
-    cst[_C_PERM0] = p0
-    cst[_C_PERM0 + 1] = p1
-    cst[_C_PERM0 + 2] = p2
-    cst[_C_SGN0] = 1.0
-    cst[_C_SGN0 + 1] = s1
-    cst[_C_SGN0 + 2] = 1.0
-    cst[_C_M0S] = M1u
-    cst[_C_M0S + 1] = M2u
-    cst[_C_M0S + 2] = M3u
-    # --- exact power-of-two scaling: max |M| and max I in [0.5, 1) ---
-    mmax = max(max(abs(M1u), abs(M2u)), abs(M3u))
-    eM = 0 if mmax == 0.0 else math.frexp(mmax)[1]
-    eI = math.frexp(I3u)[1]
-    fM = _pow2(-eM)
-    fI = _pow2(-eI)
-    M1 = _ldexp(M1u, fM, -eM)
-    M2 = _ldexp(M2u, fM, -eM)
-    M3 = _ldexp(M3u, fM, -eM)
-    I1 = _ldexp(I1u, fI, -eI)
-    I2 = _ldexp(I2u, fI, -eI)
-    I3 = _ldexp(I3u, fI, -eI)
-    cst[_C_EM] = eM
-    cst[_C_ESCALE] = eM - eI
-    cst[_C_MSCALE] = _pow2(eM)
-    cst[_C_TSCALE] = _pow2(eM - eI)
+    eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = _setup_pre(i0, i1, i2, m0, m1_, m2, cst)
+    if eq:
+        return True
+    rf0 = _params(m, m1, rx, ry, 1.0, do_rf, cst)
+    _setup_post(cst, rf0, c0, s0, M1, M2, M3)
+    return False
 
-    # --- regime (see motion._constants) ---
+
+def _dv(a, b):
+    """``a / b`` with IEEE results for ``b = 0`` also in plain Python (compiled: the division itself).
+
+    The branch-free set-up computes both regimes' quantities and selects; the one not taken may
+    divide by zero (a symmetric top, a relative equilibrium)."""
+    if b != 0.0:
+        return a / b
+    if a != a or a == 0.0 or b != b:
+        return math.nan
+    return math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+def _perm3(i0, i1, i2):
+    """Proper signed permutation to ascending moments (a stable argsort, without branches):
+    ``(p0, p1, p2, s1)`` with ``s1 = -1`` for an odd permutation (the middle axis changes sign)."""
+    a0, a1, a2 = i0, i1, i2
+    p0, p1, p2 = 0, 1, 2
+    c = a1 < a0
+    a0, a1 = (a1, a0) if c else (a0, a1)
+    p0, p1 = (p1, p0) if c else (p0, p1)
+    c2 = a2 < a1
+    a1, a2 = (a2, a1) if c2 else (a1, a2)
+    p1, p2 = (p2, p1) if c2 else (p1, p2)
+    c3 = c2 and a1 < a0
+    p0, p1 = (p1, p0) if c3 else (p0, p1)
+    inv = (1 if p0 > p1 else 0) + (1 if p0 > p2 else 0) + (1 if p1 > p2 else 0)
+    s1 = -1.0 if inv == 1 or inv == 3 else 1.0
+    return p0, p1, p2, s1
+
+
+def _pick3(k, x0, x1, x2):
+    """``(x0, x1, x2)[k]`` without indexing a tuple by a variable."""
+    return x0 if k == 0 else (x1 if k == 1 else x2)
+
+
+def _pre_regime(M1, M2, M3, I1, I2, I3):
+    """Regime, parameter and constants of a scaled, sorted body (``motion._constants``).
+
+    Returns ``(eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y)``
+    with ``(x, y)`` the (unnormalised) amplitude of ``M(0)``; the values are meaningless where ``eq``.
+    """
     d21 = I2 - I1
     d32 = I3 - I2
     d31 = I3 - I1
@@ -944,95 +1014,136 @@ def body_setup(i0, i1, i2, m0, m1_, m2, cst):
     t1h, t1l = _quick_two_sum(p, e + pl * I3)
     dh, _ = _dd_add(t3h, t3l, -t1h, -t1l)
     D = dh / (I1 * I3)
-    eq = (
-        (msq == 0.0)
-        or (a1 == 0.0)
-        or (a3 == 0.0)
-        or ((dh == 0.0) and (M1 * M1 * d21 == 0.0) and (M3 * M3 * d32 == 0.0))
-    )
-    if eq:
-        cst[_C_REGIME] = _EQUILIBRIUM
-        return True
-    mn = math.sqrt(msq)
-    m1B = d31 * D / (d32 * a1)
-    caseB = (D > 0.0) and (m1B >= _M1_SEPARATRIX)
-    if caseB:
-        m = d21 * a3 / (d32 * a1)
-        m1 = m1B
-    else:
-        m = d32 * a1 / (d21 * a3)
-        m1 = d31 * (-D) / (d21 * a3)
-    sep = (not caseB) and (m1 < _M1_SEPARATRIX)
+    eq = (msq == 0.0) | (a1 == 0.0) | (a3 == 0.0) | ((dh == 0.0) & (M1 * M1 * d21 == 0.0) & (M3 * M3 * d32 == 0.0))
+    mn = _sqrt(msq)
+    m1B = _dv(d31 * D, d32 * a1)
+    caseB = (D > 0.0) & (m1B >= _M1_SEPARATRIX)
+    mB = _dv(d21 * a3, d32 * a1)
+    mA = _dv(d32 * a1, d21 * a3)
+    m1A = _dv(d31 * (-D), d21 * a3)
+    m = mB if caseB else mA
+    m1 = m1B if caseB else m1A
+    sep = (not caseB) & (m1 < _M1_SEPARATRIX)
     # make m + m1 = 1 with the smaller of the two computed directly
-    if m <= m1:
-        m1 = 1.0 - m
-    else:
-        m = 1.0 - m1
-    if sep:
-        m = 1.0
-        m1 = 0.0
-    else:  # np.clip (NaN stays NaN)
-        if m < 0.0:
-            m = 0.0
-        elif m > 1.0:
-            m = 1.0
-        if m1 < 0.0:
-            m1 = 0.0
-        elif m1 > 1.0:
-            m1 = 1.0
+    small_m = m <= m1
+    m1r = 1.0 - m
+    mr = 1.0 - m1
+    m1 = m1r if small_m else m1
+    m = m if small_m else mr
+    # np.clip (NaN stays NaN); on the separatrix m = 1
+    m = 0.0 if m < 0.0 else (1.0 if m > 1.0 else m)
+    m1 = 0.0 if m1 < 0.0 else (1.0 if m1 > 1.0 else m1)
+    m = 1.0 if sep else m
+    m1 = 0.0 if sep else m1
 
-    A1 = math.sqrt(a3 * I1 / d31)
-    A3 = math.sqrt(a1 * I3 / d31)
-    if caseB:
-        A2 = math.sqrt(a3 * I2 / d32)
-        lam = math.sqrt(d32 * a1 / (I1 * I2 * I3))
-        Ac = A1
-        Aa = A3
-        Mc0 = M1
-        Ma0 = M3
-    else:
-        A2 = math.sqrt(a1 * I2 / d21)
-        lam = math.sqrt(d21 * a3 / (I1 * I2 * I3))
-        Ac = A3
-        Aa = A1
-        Mc0 = M3
-        Ma0 = M1
+    A1 = _sqrt(_dv(a3 * I1, d31))
+    A3 = _sqrt(_dv(a1 * I3, d31))
+    A2B = _sqrt(_dv(a3 * I2, d32))
+    lamB = _sqrt(d32 * a1 / (I1 * I2 * I3))
+    A2A = _sqrt(_dv(a1 * I2, d21))
+    lamA = _sqrt(d21 * a3 / (I1 * I2 * I3))
+    A2 = A2B if caseB else A2A
+    lam = lamB if caseB else lamA
+    Ac = A1 if caseB else A3
+    Aa = A3 if caseB else A1
+    Mc0 = M1 if caseB else M3
+    Ma0 = M3 if caseB else M1
     sa = -1.0 if Ma0 < 0.0 else 1.0
-    sc = -1.0 if (sep and Mc0 < 0.0) else 1.0
+    sc = -1.0 if (sep & (Mc0 < 0.0)) else 1.0
 
     # precession rates and characteristics
-    if caseB:
-        rate = mn / I2
-        coef = mn * d32 * d21 / (I2 * I2 * d31 * lam)
-        nprime = I3 * d21 / (I2 * d31)
-        omnprime = I1 * d32 / (I2 * d31)  # 1 - n'
-        Nadd = nprime / omnprime
-        nu = m + nprime * m1
-        omnu = m1 * omnprime
-    else:
-        rate = mn / I3
-        coef = mn * d32 * d31 / (I3 * I3 * d21 * lam)
-        Nadd = I1 * d32 / (I3 * d21)  # -nu_A
-        nu = -Nadd
-        omnu = I2 * d31 / (I3 * d21)
-    if not math.isfinite(coef):
-        coef = 0.0
-    if not math.isfinite(nu):
-        nu = 0.0
-    if not (math.isfinite(omnu) and omnu > 0.0):
-        omnu = 1.0
-    if not math.isfinite(Nadd):
-        Nadd = 0.0
-    Cadd = math.sqrt(Nadd * (Nadd + m) * (1.0 + Nadd))
+    rateB = mn / I2
+    coefB = _dv(mn * d32 * d21, I2 * I2 * d31 * lam)
+    nprime = _dv(I3 * d21, I2 * d31)
+    omnprime = _dv(I1 * d32, I2 * d31)  # 1 - n'
+    NaddB = _dv(nprime, omnprime)
+    nuB = m + nprime * m1
+    omnuB = m1 * omnprime
+    rateA = mn / I3
+    coefA = _dv(mn * d32 * d31, I3 * I3 * d21 * lam)
+    NaddA = _dv(I1 * d32, I3 * d21)  # -nu_A
+    nuA = -NaddA
+    omnuA = _dv(I2 * d31, I3 * d21)
+    rate = rateB if caseB else rateA
+    coef = coefB if caseB else coefA
+    Nadd = NaddB if caseB else NaddA
+    nu = nuB if caseB else nuA
+    omnu = omnuB if caseB else omnuA
+    coef = coef if math.isfinite(coef) else 0.0
+    nu = nu if math.isfinite(nu) else 0.0
+    omnu = omnu if (math.isfinite(omnu) & (omnu > 0.0)) else 1.0
+    Nadd = Nadd if math.isfinite(Nadd) else 0.0
+    Cadd = _sqrt(Nadd * (Nadd + m) * (1.0 + Nadd))
     g0 = 1.0 + Nadd if caseB else 1.0
 
     # initial phase: amplitude (c0, s0) of (sc Mc/Ac, sa sc M2/A2)
-    x = sc * Mc0 / Ac
-    y = sa * sc * M2 / A2
-    h = math.hypot(x, y)
-    c0 = x / h
-    s0 = y / h
+    x = _dv(sc * Mc0, Ac)
+    y = _dv(sa * sc * M2, A2)
+    return eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y
 
+
+def _pre_amplitude(h, x, y, m, m1):
+    """``(c0, s0, delta^2)`` of the initial phase from ``h = hypot(x, y)``."""
+    c0 = _dv(x, h)
+    s0 = _dv(y, h)
+    s2 = s0 * s0
+    delta2 = 1.0 - m * s2 if m <= 0.5 else c0 * c0 + m1 * s2
+    return c0, s0, delta2
+
+
+def _setup_pre(i0, i1, i2, m0, m1_, m2, cst):
+    """First part of :func:`body_setup`, up to :func:`_params`.
+
+    Returns ``(eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3)``: the
+    equilibrium flag, the parameter, the first two arguments of the ``R_F`` of
+    the initial phase and whether it is needed, the initial amplitude and the
+    sorted, scaled ``M0`` (benign placeholders for an equilibrium).
+    """
+    # --- proper signed permutation to ascending moments (stable argsort) ---
+    p0, p1, p2, s1 = _perm3(i0, i1, i2)
+    I1u = _pick3(p0, i0, i1, i2)
+    I2u = _pick3(p1, i0, i1, i2)
+    I3u = _pick3(p2, i0, i1, i2)
+    M1u = 1.0 * _pick3(p0, m0, m1_, m2)
+    M2u = s1 * _pick3(p1, m0, m1_, m2)
+    M3u = 1.0 * _pick3(p2, m0, m1_, m2)
+    cst[_C_PERM0] = p0
+    cst[_C_PERM0 + 1] = p1
+    cst[_C_PERM0 + 2] = p2
+    cst[_C_SGN0] = 1.0
+    cst[_C_SGN0 + 1] = s1
+    cst[_C_SGN0 + 2] = 1.0
+    cst[_C_M0S] = M1u
+    cst[_C_M0S + 1] = M2u
+    cst[_C_M0S + 2] = M3u
+    # --- exact power-of-two scaling: max |M| and max I in [0.5, 1) ---
+    mmax = max(max(abs(M1u), abs(M2u)), abs(M3u))
+    eM = 0 if mmax == 0.0 else _exponent(mmax)
+    eI = _exponent(I3u)
+    fM = _pow2(-eM)
+    fI = _pow2(-eI)
+    M1 = _ldexp(M1u, fM, -eM)
+    M2 = _ldexp(M2u, fM, -eM)
+    M3 = _ldexp(M3u, fM, -eM)
+    I1 = _ldexp(I1u, fI, -eI)
+    I2 = _ldexp(I2u, fI, -eI)
+    I3 = _ldexp(I3u, fI, -eI)
+    cst[_C_EM] = eM
+    cst[_C_ESCALE] = eM - eI
+    cst[_C_MSCALE] = _pow2(eM)
+    cst[_C_TSCALE] = _pow2(eM - eI)
+    eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _pre_regime(
+        M1, M2, M3, I1, I2, I3)
+    if eq:
+        cst[_C_REGIME] = _EQUILIBRIUM
+        return True, 0.5, 0.5, 1.0, 1.0, False, 1.0, 0.0, 0.0, 0.0, 0.0
+    c0, s0, delta2 = _pre_amplitude(math.hypot(x, y), x, y, m, m1)
+    _pre_store(cst, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0)
+    return False, m, m1, c0 * c0, delta2, not sep, c0, s0, M1, M2, M3
+
+
+def _pre_store(cst, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0):
+    """The constants of :func:`_setup_pre` into ``cst`` (all but the sorting and scaling data)."""
     cst[_C_REGIME] = _SEPARATRIX if sep else (_REGIME_B if caseB else _REGIME_A)
     cst[_C_CASEB] = 1.0 if caseB else 0.0
     cst[_C_SEP] = 1.0 if sep else 0.0
@@ -1044,13 +1155,26 @@ def body_setup(i0, i1, i2, m0, m1_, m2, cst):
     cst[_C_HAVE_JCD] = 0.0
     cst[_C_HAVE_JFAR0] = 0.0
     cst[_C_HAVE_T0] = 0.0
-    # F(phi0|m) = s0 R_F(c0^2, delta^2, 1), K and the Landen chain at once
-    s2 = s0 * s0
-    if m <= 0.5:
-        delta2 = 1.0 - m * s2
-    else:
-        delta2 = c0 * c0 + m1 * s2
-    rf0 = _params(m, m1, c0 * c0, delta2, 1.0, not sep, cst)
+    cst[_C_LAM] = lam
+    cst[_C_AC] = Ac
+    cst[_C_A2] = A2
+    cst[_C_AA] = Aa
+    cst[_C_SA] = sa
+    cst[_C_SC] = sc
+    cst[_C_RATE] = rate
+    cst[_C_COEF] = coef
+    cst[_C_NADD] = Nadd
+    cst[_C_CADD] = Cadd
+    cst[_C_G0] = g0
+    cst[_C_NUD] = -Nadd if caseB else nu
+    cst[_C_OMNUD] = 1.0 + Nadd if caseB else omnu
+
+
+def _setup_post(cst, rf0, c0, s0, M1, M2, M3):
+    """Last part of :func:`body_setup`, after :func:`_params`: ``tau0`` and the remaining constants."""
+    sep = cst[_C_SEP] != 0.0
+    caseB = cst[_C_CASEB] != 0.0
+    sa = cst[_C_SA]
     kh = cst[_C_KH]
     kl = cst[_C_KL]
     if sep:
@@ -1067,25 +1191,8 @@ def body_setup(i0, i1, i2, m0, m1_, m2, cst):
             t0h = F0
             t0l = 0.0
 
-    cst[_C_LAM] = lam
     cst[_C_T0H] = t0h
     cst[_C_T0L] = t0l
-    cst[_C_AC] = Ac
-    cst[_C_A2] = A2
-    cst[_C_AA] = Aa
-    cst[_C_SA] = sa
-    cst[_C_SC] = sc
-    cst[_C_RATE] = rate
-    cst[_C_COEF] = coef
-    cst[_C_NADD] = Nadd
-    cst[_C_CADD] = Cadd
-    cst[_C_G0] = g0
-    if caseB:
-        cst[_C_NUD] = -Nadd
-        cst[_C_OMNUD] = 1.0 + Nadd
-    else:
-        cst[_C_NUD] = nu
-        cst[_C_OMNUD] = omnu
     cst[_C_KFULL] = math.inf if sep else kh
     qw, qx, qy, qz = _qmin(M1, M2, M3, caseB, sa)
     cst[_C_Q0W] = qw
@@ -1183,7 +1290,7 @@ def body_eval(cst, t):
         tw, tx, ty, tz = _qmin(M1, M2, M3, caseB, sa)
         uw, ux, uy, uz = _qmul(ca, ex, 0.0, ez, tw, tx, ty, tz)
         qw, qx, qy, qz = _qmul(cst[_C_Q0W], -cst[_C_Q0X], -cst[_C_Q0Y], -cst[_C_Q0Z], uw, ux, uy, uz)
-        nq = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        nq = _sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
         qw = qw / nq
         qk0 = qx / nq
         qk1 = qy / nq
@@ -1211,7 +1318,7 @@ def equilibrium_eval(i0, i1, i2, m0, m1, m2, t):
     o0 = m0 / i0
     o1 = m1 / i1
     o2 = m2 / i2
-    w = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+    w = _sqrt(o0 * o0 + o1 * o1 + o2 * o2)
     ws = w if w > 0.0 else 1.0
     half = 0.5 * w * t
     sh = math.sin(half)
@@ -1230,11 +1337,10 @@ def free_flow(i0, i1, i2, m0, m1, m2, t, cst):
     return body_eval(cst, t)
 
 
-def motion_kernel(inertia, M0, t, Mout, qout):
-    """Fill ``Mout`` (nb, T, 3) and ``qout`` (nb, T, 4) for bodies (nb, 3) and times (T,).
+def motion_kernel_scalar(inertia, M0, t, Mout, qout):
+    """:func:`motion_kernel` one (body, time) after the other (the reference of the lane kernel).
 
-    Inputs are validated by the caller (finite, moments > 0, C-contiguous
-    float64).  O(1) memory per body.
+    O(1) memory per body.
     """
     nb = inertia.shape[0]
     T = t.shape[0]
@@ -1309,6 +1415,11 @@ if USE_NUMBA:  # pragma: no branch
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)
 
+    def _jiti(f):
+        """Small helpers: inlined into their callers by numba (a call between compiled functions
+        is otherwise an indirect call that LLVM can neither inline nor vectorize)."""
+        return _njit(cache=True, nogil=True, error_model="numpy", forceinline=True)(f)
+
     @_intrinsic
     def _fma(typingctx, a, b, c):
         """``a * b + c`` rounded once (LLVM ``llvm.fma.f64``)."""
@@ -1321,52 +1432,130 @@ if USE_NUMBA:  # pragma: no branch
 
         return sig, codegen
 
+    @_intrinsic
+    def _sqrt(typingctx, x):  # noqa: F811 - the compiled version is the LLVM intrinsic
+        """Correctly rounded ``sqrt(x)`` (``llvm.sqrt.f64``, bitwise equal to the C library's)."""
+        sig = _types.float64(_types.float64)
+
+        def codegen(context, builder, signature, args):
+            d = _ir.DoubleType()
+            fn = builder.module.declare_intrinsic("llvm.sqrt", [d], _ir.FunctionType(d, [d]))
+            return builder.call(fn, args)
+
+        return sig, codegen
+
+    @_intrinsic
+    def _bits(typingctx, x):
+        """The bits of a float64 as an int64 (LLVM ``bitcast``)."""
+        sig = _types.int64(_types.float64)
+
+        def codegen(context, builder, signature, args):
+            return builder.bitcast(args[0], _ir.IntType(64))
+
+        return sig, codegen
+
+    @_intrinsic
+    def _from_bits(typingctx, i):
+        """The float64 with the bits of an int64 (LLVM ``bitcast``)."""
+        sig = _types.float64(_types.int64)
+
+        def codegen(context, builder, signature, args):
+            return builder.bitcast(args[0], _ir.DoubleType())
+
+        return sig, codegen
+
+    def _pow2(k):  # noqa: F811 - compiled: built from its bits (numba's ldexp is a call into its helper library)
+        if -1022 <= k <= 1023:
+            return _from_bits((k + 1023) << 52)
+        return 0.0
+
+    def _exponent(x):  # noqa: F811 - compiled: read from the bits where x is normal (the same number)
+        be = (_bits(x) >> 52) & 0x7FF
+        if be != 0:
+            return be - 1022
+        return math.frexp(x)[1]
+
+    def _exponent_lane(x):  # noqa: F811 - compiled: the exponent bits, no call (vectorizes)
+        be = (_bits(x) >> 52) & 0x7FF
+        return be - 1022, be != 0
+
     def _two_prod_f(a, b):  # noqa: F811 - the compiled version uses the FMA
         p = a * b
         return p, _fma(a, b, -p)
 
-    _two_sum = _jit(_two_sum)
-    _quick_two_sum = _jit(_quick_two_sum)
-    _split = _jit(_split)
-    _two_prod = _jit(_two_prod)
-    _dd_add = _jit(_dd_add)
-    _dd_mul = _jit(_dd_mul)
-    _two_prod_f = _jit(_two_prod_f)
-    _dd_mul_f = _jit(_dd_mul_f)
-    _dd_mul_d_f = _jit(_dd_mul_d_f)
-    _dd_div_f = _jit(_dd_div_f)
-    _dd_sqrt_f = _jit(_dd_sqrt_f)
-    _pow2 = _jit(_pow2)
-    _ldexp = _jit(_ldexp)
-    _rf_poly = _jit(_rf_poly)
-    _rc1 = _jit(_rc1)
-    _rj_init = _jit(_rj_init)
-    _rj_step = _jit(_rj_step)
-    _rj_finish = _jit(_rj_finish)
+    _two_sum = _jiti(_two_sum)
+    _quick_two_sum = _jiti(_quick_two_sum)
+    _split = _jiti(_split)
+    _two_prod = _jiti(_two_prod)
+    _dd_add = _jiti(_dd_add)
+    _dd_mul = _jiti(_dd_mul)
+    _two_prod_f = _jiti(_two_prod_f)
+    _dd_mul_f = _jiti(_dd_mul_f)
+    _dd_mul_d_f = _jiti(_dd_mul_d_f)
+    _dd_div_f = _jiti(_dd_div_f)
+    _dd_sqrt_f = _jiti(_dd_sqrt_f)
+    _pow2 = _jiti(_pow2)
+    _exponent = _jiti(_exponent)
+    _exponent_lane = _jiti(_exponent_lane)
+    _ldexp = _jiti(_ldexp)
+    _rf_poly = _jiti(_rf_poly)
+    _rc1_series = _jiti(_rc1_series)
+    _rc1 = _jiti(_rc1)
+    _rj_init = _jiti(_rj_init)
+    _rj_step = _jiti(_rj_step)
+    _rj_finish = _jiti(_rj_finish)
     _rj3 = _jit(_rj3)
     _params = _jit(_params)
-    _sech = _jit(_sech)
-    _reduce = _jit(_reduce)
-    _real_start = _jit(_real_start)
-    _real_level = _jit(_real_level)
-    _imag_start = _jit(_imag_start)
-    _imag_level = _jit(_imag_level)
-    _finish = _jit(_finish)
+    _sech = _jiti(_sech)
+    _reduce = _jiti(_reduce)
+    _real_start = _jiti(_real_start)
+    _real_level = _jiti(_real_level)
+    _imag_start = _jiti(_imag_start)
+    _imag_level = _jiti(_imag_level)
+    _dn = _jiti(_dn)
+    _mod2 = _jiti(_mod2)
+    _mod4 = _jiti(_mod4)
+    _mod8 = _jiti(_mod8)
+    _quadrant = _jiti(_quadrant)
+    _finish = _jiti(_finish)
     _sncndn3 = _jit(_sncndn3)
-    _jtot_args = _jit(_jtot_args)
-    _jtot_from = _jit(_jtot_from)
+    _jtot_args = _jiti(_jtot_args)
+    _jtot_from = _jiti(_jtot_from)
     _jtot = _jit(_jtot)
     _get_jc = _jit(_get_jc)
     _get_jcd = _jit(_get_jcd)
-    _theta = _jit(_theta)
-    _jsep = _jit(_jsep)
+    _theta_v = _jiti(_theta_v)
+    _theta = _jiti(_theta)
+    _jsep = _jiti(_jsep)
+    _near_xadd = _jiti(_near_xadd)
     _near = _jit(_near)
     _far = _jit(_far)
-    _qmin = _jit(_qmin)
-    _qmul = _jit(_qmul)
+    _qmin = _jiti(_qmin)
+    _qmul = _jiti(_qmul)
+    def _dv(a, b):  # noqa: F811 - compiled: the IEEE division (error_model="numpy")
+        return a / b
+
+    _dv = _jiti(_dv)
+    _perm3 = _jiti(_perm3)
+    _pick3 = _jiti(_pick3)
+    _pre_regime = _jiti(_pre_regime)
+    _pre_amplitude = _jiti(_pre_amplitude)
+    _pre_store = _jiti(_pre_store)
+    _setup_pre = _jit(_setup_pre)
+    _setup_post = _jit(_setup_post)
     body_setup = _jit(body_setup)
     body_eval = _jit(body_eval)
     equilibrium_eval = _jit(equilibrium_eval)
     free_flow = _jit(free_flow)
-    motion_kernel = _jit(motion_kernel)
+    motion_kernel_scalar = _jit(motion_kernel_scalar)
     constants_kernel = _jit(constants_kernel)
+
+# the lane kernel (imported last: it reads this module's constants and compiled helpers).
+# motion_kernel(inertia, M0, t, Mout, qout): fill Mout (nb, T, 3) and qout (nb, T, 4) for bodies
+# (nb, 3) and times (T,), inputs validated by the caller (finite, moments > 0, C-contiguous
+# float64): the lane kernel lanes.motion_lanes (sixteen evaluations in lockstep), whose results are
+# those of motion_kernel_scalar bit for bit. (lanes sets it too, should it be imported first.)
+from . import lanes as _lanes  # noqa: E402
+
+if hasattr(_lanes, "motion_lanes"):  # pragma: no branch
+    motion_kernel = _lanes.motion_lanes

@@ -123,11 +123,12 @@ symmetric tops are the limits ``m = 0`` (regime B for ``I1 = I2``, A for
 *Implementation.*  The functions below are vectorized NumPy code (the
 reference, and the fallback when numba is not installed or
 ``EULERPOISSON_NO_NUMBA=1``).  When numba is available :func:`exact_motion`
-and :func:`exact_constants` run the compiled scalar kernels of
-:mod:`eulerpoisson.solvers.exact.kernels` instead: the same floating-point
-operations in the same order, one (body, time) at a time with O(1) memory,
-bitwise equal to this module where both use the C library's elementary
-functions (to a few ulp otherwise).
+and :func:`exact_constants` run the compiled kernels of
+:mod:`eulerpoisson.solvers.exact.kernels` instead (for :func:`exact_motion`
+the lane kernel of :mod:`eulerpoisson.solvers.exact.lanes`, sixteen
+evaluations in lockstep): the same floating-point operations in the same
+order, with O(1) memory per body, bitwise equal to this module where both use
+the C library's elementary functions (to a few ulp otherwise).
 
 References
 ----------
@@ -746,20 +747,22 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK):
     ``M0``) are evaluated as the separatrix.
 
     Cost (one x86-64 core, CPU time): with numba (the default when it is
-    installed) the compiled scalar kernels of
-    :mod:`eulerpoisson.solvers.exact.kernels` run, about 0.45 microseconds per
-    (body, time) including the attitude, and 0.8-1.1 microseconds for a
-    body evaluated at a single time (set-up included); memory O(1) per body
-    (``chunk_size`` is then irrelevant).  The first call in a fresh
-    environment compiles the kernels (about 8 s, cached on disk).  Without
-    numba, or with the environment variable ``EULERPOISSON_NO_NUMBA=1``, the
-    vectorized NumPy path runs (the reference; about 1 microsecond per
-    (body, time) plus ~4 microseconds per body, and ~2 ms of overhead per
-    call).  Both paths perform the same floating-point operations in the
-    same order: they agree bitwise when NumPy uses the C library's
-    elementary functions, and to a few ulp of the intermediate quantities
-    otherwise (NumPy's SIMD ``exp``, ``tanh``, ``atan``, ... differ by 1-3
-    ulp).
+    installed) the compiled lane kernel of
+    :mod:`eulerpoisson.solvers.exact.lanes` runs (sixteen evaluations in
+    lockstep, SIMD; the results of the scalar kernels of
+    :mod:`eulerpoisson.solvers.exact.kernels` bit for bit): about 0.15
+    microseconds per (body, time) including the attitude, and 0.6
+    microseconds for a body evaluated at a single time (set-up included;
+    benchmarks/bench_exact.py); memory O(1) per body (``chunk_size`` is then
+    irrelevant).  The first call in a fresh environment compiles the kernels
+    (about 20 s, cached on disk).  Without numba, or with the environment
+    variable ``EULERPOISSON_NO_NUMBA=1``, the vectorized NumPy path runs (the
+    reference; about 1 microsecond per (body, time) plus ~4 microseconds per
+    body, and ~2 ms of overhead per call).  Both paths perform the same
+    floating-point operations in the same order: they agree bitwise when NumPy
+    uses the C library's elementary functions, and to a few ulp of the
+    intermediate quantities otherwise (NumPy's SIMD ``exp``, ``tanh``,
+    ``atan``, ... differ by 1-3 ulp).
 
     Examples
     --------

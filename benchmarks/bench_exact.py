@@ -1,0 +1,200 @@
+"""Where the exact method's time goes, one thread: the Monte-Carlo case and one body at many times.
+
+* ``exact_montecarlo``: N distinct bodies (principal moments uniform in [1, 1.9], Omega0 of
+  random direction with the length of the reference Omega0, fixed seed) each at one time
+  (t = 10), ``solve(RigidBody(moments (N, 3)), [t], omega0=(N, 3))`` with the attitude:
+  evaluations per second (the issue's goal: >= 2e6 per core); ``exact_montecarlo_kernel`` the
+  same through the kernel alone (``exact_motion``), ``exact_montecarlo_scalar`` through the
+  scalar kernel (one evaluation after the other, the reference of the lane kernel);
+* ``exact_many_times``: one body (the reference problem) at 10^5 times in [0, 100] through
+  ``solve``: microseconds per evaluation (goal: <= 0.3); ``_kernel`` and ``_scalar`` likewise;
+* ``exact_counts_montecarlo`` / ``exact_counts_many_times``: the elliptic work per body (per
+  time), counted by running the kernels as plain Python in a subprocess
+  (``EULERPOISSON_NO_NUMBA=1``; the same code numba compiles): Jacobi arguments (each a
+  reduction modulo K and a Landen ascent), Carlson R_J and R_F integrals, AGMs for K(m), the
+  closed-form R_C terms of the R_J duplications and the C library calls. benchmarks/README.md
+  ("Where the exact method's time goes") compares them with the least the formulas need.
+
+    .venv/bin/python benchmarks/run.py --only exact [--quick]
+    .venv/bin/python benchmarks/bench_exact.py --counts N T     # the counts alone, as JSON
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import _common as C
+
+HERE = Path(__file__).resolve().parent
+T_MC = 10.0
+
+
+def bodies(n: int, seed: int = 20261124):
+    """Principal moments (n, 3), uniform in [1, 1.9] (triangle inequality holds), and Omega0 (n, 3)."""
+    rng = np.random.default_rng(seed)
+    mom = rng.uniform(1.0, 1.9, (n, 3))
+    v = rng.standard_normal((n, 3))
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    return mom, v * np.linalg.norm(C.OMEGA0)
+
+
+def _workers():
+    import inspect
+
+    import eulerpoisson as ep
+
+    return {"workers": 1} if "workers" in inspect.signature(ep.solve).parameters else {}
+
+
+def counts(nb: int, T: int) -> dict:
+    """Elliptic work per (body, time) of the kernel, counted in plain Python (call in a subprocess)."""
+    import collections
+    import math
+
+    from eulerpoisson.solvers.exact import kernels as K
+    from eulerpoisson.solvers.exact import lanes as LN
+
+    assert not K.USE_NUMBA, "counts need EULERPOISSON_NO_NUMBA=1"
+    c = collections.Counter()
+
+    def wrap(mod, name, key, weigh=None):
+        f = getattr(mod, name)
+
+        def g(*a):
+            c[key] += 1 if weigh is None else weigh(*a)
+            return f(*a)
+
+        setattr(mod, name, g)
+
+    L = LN.LANES
+    wrap(LN, "_rj_jobs", "R_J", lambda X, Y, Z, P, R, n: n)
+    wrap(K, "_rj3", "R_J", lambda *a: int(bool(a[4])) + int(bool(a[9])) + int(bool(a[14])))
+    wrap(LN, "_jacobi_lanes", "Jacobi arguments",
+         lambda CL, UH, UL, ON, ng, nl, O: int(sum(ON[g * L + l] != 0.0 for g in range(ng) for l in range(nl))))
+    wrap(K, "_sncndn3", "Jacobi arguments", lambda k, *a: k)
+    wrap(K, "_rf_poly", "R_F")
+    wrap(K, "_dd_div_f", "K(m) (AGM in double-double)")
+    wrap(K, "_rc1", "R_C closed forms (atan/log1p) in R_J")
+
+    class _Math:
+        def __getattr__(self, name):
+            f = getattr(math, name)
+            if name in ("atan2", "sin", "cos", "sinh", "cosh", "atan", "log1p", "hypot", "asinh", "tanh", "exp"):
+                def g(*a):
+                    c[f"libm {name}"] += 1
+                    return f(*a)
+                return g
+            return f
+
+    K.math = _Math()
+    LN.math = _Math()
+    mom, w0 = bodies(nb)
+    t = np.linspace(T_MC if T == 1 else 0.0, T_MC if T == 1 else 100.0, T)
+    if T > 1:
+        mom, w0 = np.array([C.INERTIA]), np.array([C.OMEGA0])
+    M0 = np.ascontiguousarray(w0 * mom)
+    Mo = np.empty((len(mom), T, 3))
+    qo = np.empty((len(mom), T, 4))
+    K.motion_kernel(np.ascontiguousarray(mom), M0, t, Mo, qo)
+    n = len(mom) * T
+    return {k: v / n for k, v in sorted(c.items())}
+
+
+def _counts_subprocess(nb: int, T: int) -> dict:
+    env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
+    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--counts", str(nb), str(T)],
+                         capture_output=True, text=True, env=env, timeout=1800, cwd=str(HERE))
+    if out.returncode != 0:
+        raise RuntimeError(out.stderr[-2000:])
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def run(quick: bool = False, log=print) -> dict:
+    import eulerpoisson as ep
+    from eulerpoisson.solvers.exact import kernels as K
+    from eulerpoisson.solvers.exact.motion import exact_motion
+
+    cfg = {
+        "montecarlo_bodies": 2000 if quick else 100_000,
+        "montecarlo_time": T_MC,
+        "many_times": 2000 if quick else 100_000,
+        "count_bodies": 64 if quick else 1000,
+        "count_times": 64 if quick else 2000,
+    }
+    repeats = 1 if quick else 7
+    wk = _workers()
+    out = {"config": cfg, "rows": []}
+
+    def add(name, label, value, unit, **extra):
+        out["rows"].append({"name": name, "label": label, "value": value, "unit": unit, **extra})
+        log(f"  {label:64s} {value:12.4g} {unit}")
+
+    def kernel_scalar(mom, M0, t):
+        Mo = np.empty((len(mom), len(t), 3))
+        qo = np.empty((len(mom), len(t), 4))
+        K.motion_kernel_scalar(np.ascontiguousarray(mom), np.ascontiguousarray(M0), np.ascontiguousarray(t), Mo, qo)
+
+    # Monte-Carlo: distinct bodies, one time each ----------------------------------------------
+    N = cfg["montecarlo_bodies"]
+    mom, w0 = bodies(N)
+    body = ep.RigidBody(mom)
+    tt = np.array([T_MC])
+    wall, _, n = C.best_time(lambda: ep.solve(body, tt, omega0=w0, method="exact", **wk), repeats=repeats,
+                             budget=20)
+    add("exact_montecarlo", f"exact Monte-Carlo via solve ({N} bodies x 1 time, attitude)", N / wall,
+        "evaluations/s", us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+    M0 = w0 * mom
+    wall, _, n = C.best_time(lambda: exact_motion(mom, M0, tt), repeats=repeats, budget=20)
+    add("exact_montecarlo_kernel", f"exact Monte-Carlo, kernel alone ({N} x 1)", N / wall, "evaluations/s",
+        us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+    scalar = K.USE_NUMBA and hasattr(K, "motion_kernel_scalar")  # (absent before the lane kernel)
+    if scalar:
+        wall, _, n = C.best_time(lambda: kernel_scalar(mom, M0, tt), repeats=repeats, budget=20)
+        add("exact_montecarlo_scalar", f"exact Monte-Carlo, scalar kernel (reference of the lanes) ({N} x 1)",
+            N / wall, "evaluations/s", us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+
+    # one body at many times ---------------------------------------------------------------------
+    T = cfg["many_times"]
+    t = np.linspace(0.0, 100.0, T)
+    wall, _, n = C.best_time(lambda: ep.solve(list(C.INERTIA), t, omega0=C.OMEGA0, method="exact", **wk),
+                             repeats=repeats, budget=20)
+    add("exact_many_times", f"exact one body at {T} times via solve, per evaluation", wall / T * 1e6,
+        "us/evaluation", time_s=wall, timed_calls=n)
+    I1 = np.array([C.INERTIA])
+    M1 = I1 * np.array([C.OMEGA0])
+    wall, _, n = C.best_time(lambda: exact_motion(I1, M1, t), repeats=repeats, budget=20)
+    add("exact_many_times_kernel", f"exact one body at {T} times, kernel alone, per evaluation", wall / T * 1e6,
+        "us/evaluation", time_s=wall, timed_calls=n)
+    if scalar:
+        wall, _, n = C.best_time(lambda: kernel_scalar(I1, M1, t), repeats=repeats, budget=20)
+        add("exact_many_times_scalar", f"exact one body at {T} times, scalar kernel, per evaluation",
+            wall / T * 1e6, "us/evaluation", time_s=wall, timed_calls=n)
+
+    # the elliptic work, counted ---------------------------------------------------------------
+    for name, nb, TT, per in (("montecarlo", cfg["count_bodies"], 1, "body"),
+                              ("many_times", 1, cfg["count_times"], "time")):
+        try:
+            cnt = _counts_subprocess(nb, TT)
+        except Exception as exc:  # pragma: no cover - reported, not fatal
+            log(f"  counts ({name}) failed: {exc}")
+            continue
+        add(f"exact_counts_{name}", f"exact {name}: elliptic work per {per} (counted)",
+            cnt.get("R_J", 0.0), f"R_J per {per}", counts=cnt)
+        log("    " + ", ".join(f"{k} {v:.3g}" for k, v in cnt.items()))
+    return out
+
+
+if __name__ == "__main__":  # pragma: no cover
+    if len(sys.argv) >= 2 and sys.argv[1] == "--counts":
+        print(json.dumps(counts(int(sys.argv[2]), int(sys.argv[3]))))
+        sys.exit(0)
+    import runpy
+
+    sys.argv = [sys.argv[0], "--only", "exact", *sys.argv[1:]]
+    runpy.run_path(str(Path(__file__).with_name("run.py")), run_name="__main__")

@@ -1,11 +1,11 @@
-# Two commands on a fresh machine: `make demo` and `make test`.
+# Two commands on a fresh machine: `make demo` and `make test` (and `make docs` for the site).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 # pytest-xdist workers; 2 cores on CI
 WORKERS ?= auto
 
-.PHONY: demo test bench venv clean browser mujoco
+.PHONY: demo test bench docs venv clean browser mujoco
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -17,11 +17,18 @@ $(VENV)/.installed-all: pyproject.toml | $(BIN)/python
 
 $(VENV)/.installed-test: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	@touch $@ $(VENV)/.installed-all $(VENV)/.installed-docs
+
+$(VENV)/.installed-docs: pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[docs]'
 	@touch $@ $(VENV)/.installed-all
 
 venv: $(VENV)/.installed-test
 
+# the warm-up compiles every numba kernel into its on-disk cache once (under a minute on two cores the first
+# time, seconds after): later runs start without compiling (issue 15, cold start)
 demo: $(VENV)/.installed-all
+	$(BIN)/eulerpoisson warmup
 	$(BIN)/eulerpoisson demo --out out
 
 # Chromium for the animation's browser test: installed where possible (Debian, as root),
@@ -52,5 +59,13 @@ $(VENV)/.installed-peers: | $(VENV)/.installed-test
 bench: $(VENV)/.installed-test $(VENV)/.installed-peers
 	$(BIN)/python benchmarks/run.py
 
+# the documentation site into docs/_build/html: Sphinx, warnings and broken references are errors; runs the
+# gallery (examples/) and the paper's audit (SPHINXOPTS="-D plot_gallery=0 -D eulerpoisson_run_audit=0" skips both)
+SPHINXOPTS ?=
+docs: $(VENV)/.installed-docs
+	MPLBACKEND=Agg $(BIN)/python -m sphinx -b html -n -W --keep-going $(SPHINXOPTS) docs docs/_build/html
+	@echo "open docs/_build/html/index.html"
+
 clean:
-	rm -rf $(VENV) out .pytest_cache .hypothesis
+	rm -rf $(VENV) out .pytest_cache .hypothesis docs/_build docs/auto_examples docs/api/generated \
+	  docs/api/eulerpoisson*.rst docs/api/modules.rst.inc docs/theory/audit_report.md

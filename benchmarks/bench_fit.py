@@ -32,8 +32,9 @@ SIGMA = 2e-3
 
 def observations(n, t_end, seed=0):
     """(t, noisy attitudes, noisy rates) from the closed form."""
-    import eulerpoisson as ep
     from scipy.spatial.transform import Rotation
+
+    import eulerpoisson as ep
 
     t = np.linspace(0.0, t_end, n)
     tr = ep.solve(ep.RigidBody(MOMENTS), t, omega0=OMEGA0, attitude0=Q0)
@@ -68,7 +69,7 @@ def run(quick: bool = False, log=print) -> dict:
     ep.fit(*observations(20, 5.0)[:1], attitude=observations(20, 5.0)[1], attitude_sigma=SIGMA)  # compile
     for name, n, t_end, axes in cases:
         t, q, w = observations(n, t_end)
-        wall, res, _ = C.best_time(lambda: ep.fit(t, attitude=q, attitude_sigma=SIGMA, omega=w, omega_sigma=SIGMA,
+        wall, res, _ = C.best_time(lambda t=t, q=q, w=w, axes=axes: ep.fit(t, attitude=q, attitude_sigma=SIGMA, omega=w, omega_sigma=SIGMA,
                                                   principal_axes=axes), repeats=repeats, budget=60)
         add(name, f"fit: {n} attitudes + rates, t = 0..{t_end:g}, principal_axes={axes!r}", wall, "s",
             starts=res.n_starts, optima=len(res.local_optima), reduced_chi2=res.reduced_chi2,

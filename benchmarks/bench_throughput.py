@@ -58,8 +58,8 @@ def alternate_best(fns: dict, *, repeats: int, budget: float) -> dict:
 
 
 def run(quick: bool = False, log=print) -> dict:
-    from eulerpoisson.solvers.exact.motion import exact_motion
     from eulerpoisson.solvers import solve
+    from eulerpoisson.solvers.exact.motion import exact_motion
 
     cfg = {
         "exact_bodies": 20 if quick else 1000,
@@ -119,7 +119,8 @@ def run(quick: bool = False, log=print) -> dict:
     w0 = bodies(B)
     for scheme, extra in (("splitting", {}), ("splitting4", {}), ("gauss4", {"variables": "quaternion"})):
         wall, tr, n = C.best_time(
-            lambda: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt, workers=1, **extra),
+            lambda scheme=scheme, extra=extra: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt,
+                                                     workers=1, **extra),
             repeats=repeats, budget=30)
         steps = int(tr.stats["steps"])
         add(f"symplectic_{scheme}", f"symplectic {scheme} batch ({B} bodies x {steps} steps)", B * steps / wall,
@@ -148,13 +149,27 @@ def run(quick: bool = False, log=print) -> dict:
     for name, (fn, what, count, unit) in jobs.items():
         trial = fn(cores)
         threads, amount = trial.stats["threads"], count(trial)
-        best = alternate_best({1: lambda: fn(1), cores: lambda: fn(cores)}, repeats=2 if quick else 15,
+        best = alternate_best({1: lambda fn=fn: fn(1), cores: lambda fn=fn: fn(cores)}, repeats=2 if quick else 15,
                               budget=2.0 if quick else 30.0)
         add(f"threads_{name}_1", f"{what}, 1 thread", amount / best[1], unit, time_s=best[1], workers=1)
         add(f"threads_{name}_all", f"{what}, workers={cores} (threads: {threads})", amount / best[cores], unit,
             time_s=best[cores], workers=cores, threads=threads)
         add(f"threads_{name}_speedup", f"{name}: speed-up on {cores} cores (best of alternating runs)",
             best[1] / best[cores], "x", cores=cores, threads=threads)
+
+    # taylor on every core against heyoka's ensemble propagation on as many threads -----------
+    if hy is not None:
+        jobs = {"taylor": lambda: solve(I, [tt], omega0=wt, method="taylor", tol=C.EPS, workers=cores)}
+        for per_thread in (False, True):
+            fn, bs, nb = C.heyoka_ensemble(hy, wt, tt, cores, per_thread=per_thread)
+            jobs["per_thread" if per_thread else "ensemble"] = fn
+        best = alternate_best(jobs, repeats=2 if quick else 10, budget=2.0 if quick else 30.0)
+        add("threads_taylor_vs_heyoka_taylor", f"taylor tol=eps ({Bt} bodies to t={tt:g}), workers={cores}",
+            Bt * tt / best["taylor"], "body-seconds/s", time_s=best["taylor"], workers=cores)
+        add("heyoka_ensemble", f"heyoka ensemble_propagate_until_batch, {cores} threads (SIMD {bs}, {nb} bodies)",
+            nb * tt / best["ensemble"], "body-seconds/s", time_s=best["ensemble"], workers=cores, simd_width=bs)
+        add("heyoka_per_thread", f"heyoka batch integrator per thread, {cores} threads (hand-written, {nb} bodies)",
+            nb * tt / best["per_thread"], "body-seconds/s", time_s=best["per_thread"], workers=cores, simd_width=bs)
 
     # scipy ellipj yardstick ------------------------------------------------------------
     from scipy.special import ellipj

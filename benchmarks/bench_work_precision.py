@@ -20,8 +20,6 @@ a state reset (the LLVM compilation, ~0.3 s, not timed, as numba's is not); MuJo
 
 from __future__ import annotations
 
-import numpy as np
-
 import _common as C
 
 #: error floor used in the diagram (errors below are drawn on it)

@@ -21,11 +21,17 @@ summary when present):
     times, through ``solve`` and the kernel, with the elliptic work counted: ``exact.json``;
 ``fit``
     spin-state estimation (``ep.fit``) from the default starts: 100 observations (diagonal and full
-    inertia) and 10^4 observations: ``fit.json``.
+    inertia) and 10^4 observations: ``fit.json``;
+``cold_start``
+    whole command-line processes: ``import eulerpoisson``, a warm ``eulerpoisson simulate`` of the
+    issue's small problem, ``eulerpoisson warmup`` into an empty numba cache and the first
+    ``simulate`` after it (small, and large enough for the compiled kernel): ``cold_start.json``.
 
 ``summary.md`` gathers the tables, the ratios against the peers measured in the same run and a
 PASS/MISS column for each goal of the issue, with the machine and the command. Every
-measurement uses one thread (``EULERPOISSON_WORKERS=1`` unless set), except the threads rows of
+measurement uses one thread (``EULERPOISSON_WORKERS=1`` unless set) and the compiled kernels
+(``EULERPOISSON_NUMPY_BELOW=0`` unless set: small problems too; ``cold_start`` measures the
+default, where small problems are solved by NumPy without importing numba), except the threads rows of
 the throughput benchmark, which pass ``workers=`` explicitly. ``--quick`` runs a tiny
 configuration (seconds; for the smoke test, not representative). When the full run writes to the default directory, the results block of
 benchmarks/README.md is refreshed too (``--no-readme`` to skip).
@@ -44,6 +50,9 @@ import os
 for _var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS",
              "VECLIB_MAXIMUM_THREADS", "EULERPOISSON_WORKERS"):
     os.environ.setdefault(_var, "1")
+# the compiled kernels for every problem, small ones too (by default small problems take the NumPy twins, which
+# start faster in a new process but cost more per call: the cold_start benchmark measures that default)
+os.environ.setdefault("EULERPOISSON_NUMPY_BELOW", "0")
 
 import argparse  # noqa: E402
 import json  # noqa: E402
@@ -58,7 +67,7 @@ if str(HERE) not in sys.path:
 import _common as C  # noqa: E402
 
 DEFAULT_OUT = HERE / "results"
-BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit", "exact")
+BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit", "exact", "cold_start")
 README = HERE / "README.md"
 README_START = "<!-- results:start -->"
 README_END = "<!-- results:end -->"
@@ -95,7 +104,7 @@ def _status(ok):
     return "PASS" if ok else "MISS"
 
 
-def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None) -> list[dict]:
+def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None, cold=None) -> list[dict]:
     """One row per goal of the issue: target, measured value(s), ratio to the peer, PASS/MISS/N/A."""
     goals = []
 
@@ -198,6 +207,21 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None) -> list[dict]:
         if cores == 1:
             g["measured"] += "; one usable core: nothing to scale"
     goals.append(g)
+    # taylor on every core against heyoka's ensemble propagation on the same number of threads
+    g = {"goal": "taylor batch on all cores faster than heyoka's ensemble propagation on as many threads",
+         "target": "body-seconds/s(taylor) / body-seconds/s(heyoka ensemble_propagate_until_batch) > 1"}
+    r = _row(tp["rows"], "threads_taylor_vs_heyoka_taylor") if tp else None
+    h = _row(tp["rows"], "heyoka_ensemble") if tp else None
+    if r and h:
+        hp = _row(tp["rows"], "heyoka_per_thread")
+        g["measured"] = (f"{r['value']:.3g} vs {h['value']:.3g} body-s/s on {r['workers']} threads"
+                         + (f"; heyoka with one batch integrator per thread (hand-written) {hp['value']:.3g}"
+                            if hp else ""))
+        g["ratio"] = r["value"] / h["value"]
+        g["status"] = _status(r["value"] > h["value"])
+    elif tp:
+        g["measured"] = "heyoka not installed"
+    goals.append(g)
     for g in goals:
         g.setdefault("measured", "not run")
         g.setdefault("ratio", None)
@@ -237,6 +261,24 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None) -> list[dict]:
         goals.append({"goal": "exact: one body at many times", "target": "<= 0.3 us per evaluation",
                       "measured": f"{r['value']:.3g} us via solve; kernel alone {k['value']:.3g} us",
                       "ratio": r["value"] / 0.3, "status": _status(r["value"] <= 0.3)})
+    if cold:
+        # whole processes (bench_cold_start.py)
+        r, i, n = (_row(cold["rows"], k) for k in ("cli_simulate_warm", "import_eulerpoisson", "cli_simulate_warm_nopyc"))
+        goals.append({"goal": "cold start: a warm 'eulerpoisson simulate' of 1001 samples, end to end",
+                      "target": "<= 0.5 s",
+                      "measured": f"{r['value']:.3g} s (import eulerpoisson {i['value']:.3g} s"
+                                  + (f"; without .pyc files {n['value']:.3g} s" if n else "") + ")",
+                      "ratio": r["value"] / 0.5, "status": _status(r["value"] <= 0.5)})
+        f, c, w = (_row(cold["rows"], k) for k in ("cli_first_simulate_after_warmup",
+                                                   "cli_first_compiled_simulate_after_warmup", "warmup_fresh_cache"))
+        worst = max(x["value"] for x in (f, c) if x)
+        goals.append({"goal": "cold start: the first 'eulerpoisson simulate' after the warm-up (an empty numba cache "
+                              "filled by 'eulerpoisson warmup')",
+                      "target": "<= 3 s",
+                      "measured": f"1001 samples {f['value']:.3g} s" + (f"; 2e5 samples (compiled) {c['value']:.3g} s"
+                                                                       if c else "")
+                                  + (f"; the warm-up {w['value']:.3g} s" if w else "; no warm-up run (quick)"),
+                      "ratio": worst / 3.0, "status": _status(worst <= 3.0)})
     return goals
 
 
@@ -247,7 +289,7 @@ def _fmt_ratio(r):
     return "" if r is None else f"{r:.3g}"
 
 
-def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=None, exact=None) -> str:
+def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=None, exact=None, cold=None) -> str:
     L = []
     L.append("# Benchmark summary")
     L.append("")
@@ -355,6 +397,14 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=Non
                 L.append(f"| {r['label']} | {work} | per {r['unit'].split(' per ')[-1]} |")
             else:
                 L.append(f"| {r['label']} | {r['value']:.3g} | {r['unit']} |")
+    if cold:
+        L.append("")
+        L.append("## Cold and warm starts (whole processes, best of several)")
+        L.append("")
+        L.append("| what | wall time (s) |")
+        L.append("|---|---|")
+        for r in cold["rows"]:
+            L.append(f"| {r['label']} | {r['value']:.3g} |")
     L.append("")
     L.append("## Reference points quoted by the issue (2-core machine, not measured here)")
     L.append("")
@@ -425,19 +475,19 @@ def main(argv=None) -> int:
         elif path.exists():
             results[name] = json.loads(path.read_text())
     machine["load_average_at_end"] = C.load_average()
-    wp, lr, tp, tq, ft, exact = (results.get(n) for n in BENCHMARKS)
+    wp, lr, tp, tq, ft, exact, cold = (results.get(n) for n in BENCHMARKS)
     if args.summary_only:
         # describe the machine and command of the runs that produced the JSON, not of this call
-        runs = [r for r in (wp, lr, tp, tq, ft, exact) if r]
+        runs = [r for r in (wp, lr, tp, tq, ft, exact, cold) if r]
         if runs:
             machine, command = dict(runs[0]["machine"]), runs[0]["command"]
             ends = [r["machine"].get("load_average_at_end") for r in runs]
             machine["load_average_at_end"] = max((e for e in ends if e is not None), default=None)
             args.quick = bool(runs[0].get("quick"))
-    goals = evaluate_goals(wp, lr, tp, tq, ft, exact)
+    goals = evaluate_goals(wp, lr, tp, tq, ft, exact, cold)
     C.write_json(out / "goals.json", C.envelope("goals", quick=args.quick, command=command, machine=machine,
                                                 goals=goals))
-    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq, ft, exact)
+    summary = summary_markdown(wp, lr, tp, goals, machine, command, args.quick, tq, ft, exact, cold)
     (out / "summary.md").write_text(summary)
     print(f"  -> {out / 'summary.md'}")
     for g in goals:

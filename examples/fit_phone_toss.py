@@ -1,4 +1,8 @@
-"""Fit a real tumbling body: a phone tossed into the air, flipping about its intermediate axis.
+"""
+Fitting a real tumbling body
+============================
+
+Fit a real tumbling body: a phone tossed into the air, flipping about its intermediate axis.
 
 The data (examples/tumbling_data/, see SOURCE.md there) are two phyphox gyroscope
 recordings (about 100 Hz, 0.6 s each) of a phone thrown spinning near its
@@ -10,6 +14,8 @@ predicted from the first throw's first 0.3 s against the rest of that throw.
 
 Source: R. Feng (supervisor C. Bai), "Tennis Racket Effect" (Fudan University),
 https://github.com/weenming/TRE, experiment/Raw Data_3.csv, commit 5d87b93.
+
+Run::
 
     .venv/bin/python examples/fit_phone_toss.py [OUT]
     eulerpoisson fit examples/tumbling_data/phone_toss_1.csv --plot phone_fit/toss_1
@@ -25,7 +31,10 @@ import numpy as np
 import eulerpoisson as ep
 from eulerpoisson.io.observations import read_observations
 
-DATA = Path(__file__).resolve().parent / "tumbling_data"
+try:
+    DATA = Path(__file__).resolve().parent / "tumbling_data"
+except NameError:  # sphinx-gallery runs the examples in their folder, without __file__
+    DATA = Path("tumbling_data").resolve()
 
 
 def main(out="phone_fit") -> dict:

@@ -1,4 +1,8 @@
-"""MuJoCo's free body against the exact motion: its default integrator and RK4 on the tennis racket.
+"""
+Validating MuJoCo
+=================
+
+MuJoCo's free body against the exact motion: its default integrator and RK4 on the tennis racket.
 
 A flat racket (principal moments 0.03, 0.05, 0.08 kg m^2, no gravity) spun at
 10 rad/s about its intermediate axis, with a 0.1% perturbation, for 15 s
@@ -10,8 +14,9 @@ MuJoCo's conventions for a free joint, established numerically by
 ``tests/test_oracle_mujoco.py``: ``qpos[3:7]`` is the body-to-space quaternion
 scalar first (w, x, y, z), ``qvel[3:6]`` the angular velocity in the body frame.
 
-Run: ``python examples/validate_mujoco.py [OUTDIR]`` (needs ``pip install mujoco``);
-it prints the table of the README and writes the CSVs and ``validate_mujoco.png``.
+Run: ``python examples/validate_mujoco.py [OUTDIR]`` (needs ``pip install mujoco``; the documentation
+shows it without running it where MuJoCo is not installed); it prints the table of the README and writes
+the CSVs and ``validate_mujoco.png``.
 """
 
 from __future__ import annotations
@@ -67,8 +72,9 @@ def write_csv(path, t, q, w) -> None:
 
 
 def main(out="out/mujoco") -> list:
-    from eulerpoisson.oracle import plot_report, validate
     import mujoco
+
+    from eulerpoisson.oracle import plot_report, validate
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

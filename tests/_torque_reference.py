@@ -480,7 +480,7 @@ def _integrate(system, t_fix, N, log_eps, safety=0.85, stats=None):
         scales = system.scales(state)
         # largest admissible step from the last two coefficients (in units of h)
         lrho = math.inf
-        for (name, comps), sc in zip(groups, scales):
+        for (_name, comps), sc in zip(groups, scales):
             for k in (N - 1, N):
                 la = _log_abs_max([c[k] for c in comps], P)
                 if la == -math.inf:

@@ -12,11 +12,10 @@ import pytest
 matplotlib = pytest.importorskip("matplotlib")
 
 from _reference import reference_motion  # noqa: E402
-
-from eulerpoisson.viz import animate as an  # noqa: E402
-from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.errors import InvalidInputError, MissingDependencyError  # noqa: E402
+from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.trajectory import Trajectory  # noqa: E402
+from eulerpoisson.viz import animate as an  # noqa: E402
 
 RACKET_I = np.array([3.0, 5.0, 7.0])
 

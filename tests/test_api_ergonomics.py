@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from _reference import quaternion_distance
-
 import eulerpoisson as ep
+from _reference import quaternion_distance
 from eulerpoisson import InvalidInputError
 from eulerpoisson.torques import GravityGradient
 

@@ -14,8 +14,8 @@ from scipy.spatial.transform import Rotation
 
 from eulerpoisson import attitude as at
 from eulerpoisson.attitude import Attitude
-from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError, SingularChartError
+from eulerpoisson.model.body import RigidBody
 
 try:  # tests/ as a package or as a plain directory on sys.path
     from . import strategies as S

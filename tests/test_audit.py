@@ -19,8 +19,8 @@ import pytest
 
 pytest.importorskip("sympy")
 
-from eulerpoisson.paper import audit as A  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
+from eulerpoisson.paper import audit as A  # noqa: E402
 
 #: every numbered equation of the paper (its \label{u...} values)
 NUMBERED = [f"1.{k}" for k in range(1, 31)] + ["1.15.1", "1.16.1", "1.23.1"]

@@ -109,6 +109,18 @@ def test_fit_schema(quick_run):
     assert "Spin-state estimation" in (quick_run / "summary.md").read_text()
 
 
+def test_cold_start_schema(quick_run):
+    d = _load(quick_run, "cold_start")
+    rows = {r["name"]: r for r in d["rows"]}
+    assert {"import_eulerpoisson", "cli_simulate_warm", "cli_simulate_warm_nopyc",
+            "cli_first_simulate_after_warmup"} <= set(rows)
+    for r in rows.values():
+        assert _pos(r["value"]) and r["unit"] == "s" and r["runs"] >= 1
+    goals = [g for g in _load(quick_run, "goals")["goals"] if g["goal"].startswith("cold start")]
+    assert len(goals) == 2 and all(g["status"] in ("PASS", "MISS") for g in goals)
+    assert "Cold and warm starts" in (quick_run / "summary.md").read_text()
+
+
 def test_summary_and_goals(quick_run):
     g = _load(quick_run, "goals")
     statuses = [x["status"] for x in g["goals"]]

@@ -7,8 +7,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError
+from eulerpoisson.model.body import RigidBody
 
 try:  # tests/ as a package or as a plain directory on sys.path
     from . import strategies as S

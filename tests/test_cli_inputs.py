@@ -14,9 +14,9 @@ import pytest
 
 import eulerpoisson as ep
 from eulerpoisson.cli import commands as cli
-from eulerpoisson.io.atomic import atomic_path, atomic_write_text
 from eulerpoisson.cli import main
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
+from eulerpoisson.io.atomic import atomic_path, atomic_write_text
 
 BASE = ["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "1", "--samples", "3"]
 
@@ -233,7 +233,7 @@ def test_absurd_sample_count_is_one_line(capsys):
 def test_warnings_do_not_reach_stderr(capsys, monkeypatch):
     def noisy(*a, **k):
         for _ in range(5):
-            warnings.warn("overflow encountered in multiply", RuntimeWarning)
+            warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
         np.float64(1e308) * 10  # a real numpy warning too
         raise InvalidInputError("omega0 is too large")
 
@@ -252,7 +252,7 @@ def test_real_overflow_is_one_line(capsys):
 
 def test_debug_shows_warnings(capsys, monkeypatch):
     def noisy(*a, **k):
-        warnings.warn("look at me", RuntimeWarning)
+        warnings.warn("look at me", RuntimeWarning, stacklevel=1)
         raise InvalidInputError("bad")
 
     monkeypatch.setattr(ep.solvers, "solve", noisy)

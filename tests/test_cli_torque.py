@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
-from eulerpoisson.cli import main
 from eulerpoisson.cli import commands as cli
+from eulerpoisson.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -17,8 +17,8 @@ import pytest
 
 mp = pytest.importorskip("mpmath")
 
-from eulerpoisson.numerics import elliptic as el  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
+from eulerpoisson.numerics import elliptic as el  # noqa: E402
 
 EPS = np.finfo(np.float64).eps
 M1_VALUES = [1.0, 0.5, 1e-3, 1e-8, 1e-12, 1e-15, 0.0]

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from eulerpoisson.errors import InvalidInertiaError, InvalidInputError
 from eulerpoisson.solvers.exact.motion import (
     EQUILIBRIUM,
     REGIME_A,
@@ -36,7 +37,6 @@ from eulerpoisson.solvers.exact.motion import (
     exact_constants,
     exact_motion,
 )
-from eulerpoisson.errors import InvalidInertiaError, InvalidInputError
 
 mp = pytest.importorskip("mpmath")
 

@@ -16,21 +16,20 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from _reference import quaternion_distance, reference_motion
-from eulerpoisson.model import formulations as F
 from eulerpoisson.attitude import (
     inverse_conversion_matrix,
     matrix_from_gibbs,
     metric,
     omega_from_gibbs_rate,
-    skew,
 )
-from eulerpoisson.model.body import RigidBody
 from eulerpoisson.errors import (
     InvalidInertiaError,
     InvalidInputError,
     MissingDependencyError,
     SingularChartError,
 )
+from eulerpoisson.model import formulations as F
+from eulerpoisson.model.body import RigidBody
 
 NAMES = list(F.FORMULATIONS)
 EPS = np.zeros((3, 3, 3))

@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 
 from _reference import quaternion_distance, reference_motion
-
 from eulerpoisson import InvalidInputError, RigidBody
 from eulerpoisson.solvers import available_methods, get_method, solve
 

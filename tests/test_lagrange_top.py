@@ -392,7 +392,9 @@ def test_extreme_gravity_scales(gz):
         e0, m0, _ = _invariants(case_n, np.asarray(q0), np.asarray(om0, float))
         E, mg, _ = _invariants(case_n, q, om)
         # E computed with g=1: kinetic + gz * potential; compare the total energy
-        pot = lambda qq: -mass * np.sum(np.array([0, 0, -1.0]) * _rot(qq, np.array([0.0, 0.0, ell])), -1)
+        def pot(qq):
+            return -mass * np.sum(np.array([0, 0, -1.0]) * _rot(qq, np.array([0.0, 0.0, ell])), -1)
+
         kin = E - pot(q)
         kin0 = e0 - pot(np.asarray(q0))
         tot, tot0 = kin + gz * pot(q), kin0 + gz * pot(np.asarray(q0))

@@ -16,10 +16,9 @@ import pytest
 mujoco = pytest.importorskip("mujoco", exc_type=ImportError, reason="the optional test dependency mujoco is not installed "
                                                "(pip install mujoco, or `make test` installs it where it can)")
 
-from eulerpoisson.cli import main  # noqa: E402
-
 from _reference import quaternion_distance  # noqa: E402
 from _torque_reference import reference_motion  # noqa: E402
+from eulerpoisson.cli import main  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("validate_mujoco", ROOT / "examples" / "validate_mujoco.py")
@@ -38,7 +37,7 @@ def _qmul(p, q):
 def runs(tmp_path_factory):
     out = tmp_path_factory.mktemp("mujoco")
     res = {}
-    for label, integ, dt in vm.RUNS:
+    for _label, integ, dt in vm.RUNS:
         t, q, w = vm.simulate(integ, dt)
         path = out / f"mujoco_{integ.lower()}.csv"
         vm.write_csv(path, t, q, w)

@@ -10,10 +10,9 @@ from scipy.spatial import cKDTree
 matplotlib = pytest.importorskip("matplotlib")
 
 from _reference import reference_motion  # noqa: E402
-
 from eulerpoisson.attitude import matrix_from_quaternion, quaternion_from_chart  # noqa: E402
-from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.errors import InvalidInputError, MissingDependencyError  # noqa: E402
+from eulerpoisson.model.body import RigidBody  # noqa: E402
 from eulerpoisson.trajectory import Trajectory  # noqa: E402
 from eulerpoisson.viz import plots  # noqa: E402
 

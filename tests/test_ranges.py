@@ -12,8 +12,8 @@ import pytest
 from eulerpoisson import RigidBody, solve
 from eulerpoisson.attitude import Attitude, euler_from_quaternion, quaternion_from_euler
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError, SingularChartError
+from eulerpoisson.model.formulations import formulation
 from eulerpoisson.solvers.exact.method import MAX_PHASE
-from eulerpoisson.model.formulations import MAX_GIBBS_NORM, formulation
 
 I123 = [1.0, 2.0, 3.0]
 W0 = np.array([1.0, 0.1, 0.5])

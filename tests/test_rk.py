@@ -4,10 +4,9 @@ import numpy as np
 import pytest
 
 from _reference import quaternion_distance, reference_motion
-
 from eulerpoisson import InvalidInputError
-from eulerpoisson.solvers.rk.method import INTEGRATORS, RK
 from eulerpoisson.solvers import solve
+from eulerpoisson.solvers.rk.method import INTEGRATORS, RK
 
 BODY = [[2.0, 0.3, 0.0], [0.3, 1.5, 0.1], [0.0, 0.1, 2.5]]  # full tensor
 Q0 = np.array([0.5, 0.5, -0.5, 0.5])

@@ -4,9 +4,9 @@ import json
 
 import numpy as np
 import pytest
-from _reference import quaternion_distance, reference_motion
 
 import eulerpoisson as ep
+from _reference import quaternion_distance, reference_motion
 from eulerpoisson import Attitude, RigidBody
 from eulerpoisson.errors import EulerPoissonError, InvalidInertiaError, InvalidInputError
 from eulerpoisson.solvers import available_methods, solve

@@ -12,9 +12,9 @@ xr = pytest.importorskip("xarray")
 
 from eulerpoisson import RigidBody  # noqa: E402
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError  # noqa: E402
+from eulerpoisson.io.stream import TIME_VARIABLES, TimeGrid, partial_store, solve_to_file  # noqa: E402
 from eulerpoisson.solvers import Method, MethodOptions, MethodResult, register_method, solve  # noqa: E402
 from eulerpoisson.solvers.registry import _REGISTRY  # noqa: E402
-from eulerpoisson.io.stream import TIME_VARIABLES, TimeGrid, partial_store, solve_to_file  # noqa: E402
 
 I123 = [1.0, 2.0, 3.0]
 W0 = [0.3, 1.0, 0.2]  # near the middle axis: flips, a good test of quaternion signs

@@ -17,10 +17,9 @@ pytest.importorskip("xarray")
 distributed = pytest.importorskip("distributed")
 
 from _reference import quaternion_distance, reference_motion  # noqa: E402
-
-from eulerpoisson.sweep import runner as sweep  # noqa: E402
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError  # noqa: E402
 from eulerpoisson.sweep import compute_points, load_config, load_sweep, plot_atlas, run_sweep  # noqa: E402
+from eulerpoisson.sweep import runner as sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

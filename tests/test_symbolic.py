@@ -13,8 +13,8 @@ import pytest
 
 sp = pytest.importorskip("sympy")
 
-from eulerpoisson.paper import symbolic as S  # noqa: E402
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
+from eulerpoisson.paper import symbolic as S  # noqa: E402
 
 RNG = np.random.default_rng(12345)
 I_GEN = np.array([[2.0, 0.3, -0.2], [0.3, 3.0, 0.4], [-0.2, 0.4, 4.5]])  # general, non-diagonal

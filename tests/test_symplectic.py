@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from _reference import quaternion_distance, reference_motion
-
 from eulerpoisson import EulerPoissonError, InvalidInputError
 from eulerpoisson.attitude import (
     gibbs_compose,
@@ -19,6 +18,7 @@ from eulerpoisson.attitude import (
     matrix_from_quaternion,
 )
 from eulerpoisson.solvers import charts as ch
+from eulerpoisson.solvers import solve
 from eulerpoisson.solvers.symplectic.method import (
     Symplectic,
     gauss_step,
@@ -26,7 +26,6 @@ from eulerpoisson.solvers.symplectic.method import (
     splitting_advance,
     splitting_sequence,
 )
-from eulerpoisson.solvers import solve
 
 I3 = np.array([1.0, 2.0, 3.0])
 INV = (1.0 / I3)[:, None]

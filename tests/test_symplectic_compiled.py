@@ -18,8 +18,8 @@ import pytest
 
 from eulerpoisson import EulerPoissonError
 from eulerpoisson.solvers import charts as ch
-from eulerpoisson.solvers.symplectic import kernels as K
 from eulerpoisson.solvers import solve
+from eulerpoisson.solvers.symplectic import kernels as K
 
 numba_only = pytest.mark.skipif(not K.USE_NUMBA, reason="numba not installed or EULERPOISSON_NO_NUMBA=1")
 

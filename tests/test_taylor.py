@@ -16,11 +16,12 @@ import sys
 
 import numpy as np
 import pytest
+
 from _reference import _qmul as ref_qmul
 from _reference import quaternion_distance, reference_motion
-
 from eulerpoisson import Attitude, RigidBody
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
+from eulerpoisson.solvers import get_method, solve
 from eulerpoisson.solvers.taylor import kernels as K
 from eulerpoisson.solvers.taylor.method import (
     DEFAULT_FIXED_ORDER,
@@ -29,7 +30,6 @@ from eulerpoisson.solvers.taylor.method import (
     lie_series_coefficients,
     taylor_coefficients,
 )
-from eulerpoisson.solvers import get_method, solve
 
 EPS = np.finfo(float).eps
 I123 = np.array([1.0, 2.0, 3.0])

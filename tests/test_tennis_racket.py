@@ -2,9 +2,9 @@
 
 import numpy as np
 import pytest
-from _reference import reference_motion
 from scipy.integrate import solve_ivp
 
+from _reference import reference_motion
 from eulerpoisson import RigidBody, solve
 from eulerpoisson.analysis import elliptic_parameters, flip_times, momentum_period, tennis_racket_half_period
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError

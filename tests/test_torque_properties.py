@@ -4,10 +4,9 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from strategies import batch_shapes, inertia_tensors, quaternions, rngs
-
 import eulerpoisson as ep
 from eulerpoisson.torques import BodyTorque, Gravity, GravityGradient, SpaceTorque
+from strategies import batch_shapes, inertia_tensors, quaternions, rngs
 
 
 def _torques(rng, shape):

@@ -10,10 +10,9 @@ import math
 import numpy as np
 import pytest
 
+import eulerpoisson as ep
 from _reference import quaternion_distance
 from _torque_reference import kovalevskaya_integral, reference_motion
-
-import eulerpoisson as ep
 from eulerpoisson import InvalidInputError, UnsupportedModelError
 from eulerpoisson.solvers import available_methods, get_method
 from eulerpoisson.solvers.registry import methods_supporting

@@ -5,6 +5,20 @@ formulations and its machine-checked audit, the exact (elliptic-function)
 motion, and geometric integrators.
 """
 
+from . import torques
+from .attitude.core import Attitude
+from .errors import (
+    EulerPoissonError,
+    InvalidInertiaError,
+    InvalidInputError,
+    MissingDependencyError,
+    SingularChartError,
+    UnsupportedModelError,
+)
+from .model.body import RigidBody
+from .model.equations import Model
+from .solvers import available_methods, solve
+from .trajectory import Trajectory
 
 
 def _package_version() -> str:
@@ -15,25 +29,6 @@ def _package_version() -> str:
     except PackageNotFoundError:  # pragma: no cover - running from a source tree
         return "0+unknown"
 
-
-__version__ = _package_version()
-
-from .attitude.core import Attitude
-from .model.body import RigidBody
-from .model.equations import Model
-from . import torques
-from .solvers import available_methods, solve
-from .trajectory import Trajectory
-from .estimation import FitResult, fit
-from .model.formulations import FORMULATIONS, Formulation, formulation
-from .errors import (
-    EulerPoissonError,
-    InvalidInertiaError,
-    InvalidInputError,
-    MissingDependencyError,
-    SingularChartError,
-    UnsupportedModelError,
-)
 
 __all__ = [
     "__version__",
@@ -79,7 +74,27 @@ _LAZY_MODULES = {
 }
 
 
+#: names imported on first use, as the modules above: ``fit`` (the estimation package), the formulations,
+#: and ``__version__`` (importlib.metadata) are not needed by most programs and cost about 50 ms together
+_LAZY_NAMES = {
+    "fit": ".estimation",
+    "FitResult": ".estimation",
+    "FORMULATIONS": ".model.formulations",
+    "Formulation": ".model.formulations",
+    "formulation": ".model.formulations",
+}
+
+
 def __getattr__(name):
+    if name == "__version__":
+        globals()[name] = value = _package_version()
+        return value
+    if name in _LAZY_NAMES:
+        import importlib
+
+        value = getattr(importlib.import_module(_LAZY_NAMES[name], __name__), name)
+        globals()[name] = value
+        return value
     if name in _LAZY_MODULES:
         import importlib
 

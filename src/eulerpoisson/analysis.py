@@ -27,11 +27,17 @@ without cancellation.
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
-from .util.validate import as_bool, as_float_array, as_scalar, check_broadcast
-from .model.body import check_moments
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from .errors import InvalidInputError
+from .model.body import check_moments
+from .util.validate import as_bool, as_float_array, as_scalar, check_broadcast
+
+if TYPE_CHECKING:
+    from .trajectory import Trajectory
 
 __all__ = [
     "elliptic_parameters",
@@ -45,7 +51,7 @@ __all__ = [
 ]
 
 
-def elliptic_parameters(inertia, M0) -> dict:
+def elliptic_parameters(inertia: ArrayLike, M0: ArrayLike) -> dict:
     r"""Jacobi parameter :math:`k^2`, its complement :math:`1-k^2` and the rate :math:`\lambda`.
 
     Parameters
@@ -130,7 +136,7 @@ def elliptic_parameters(inertia, M0) -> dict:
     return {"k2": k2, "k2c": k2c, "lam": float(lam), "axis": axis, "order": order}
 
 
-def momentum_period(inertia, M0) -> float:
+def momentum_period(inertia: ArrayLike, M0: ArrayLike) -> float:
     r"""Period :math:`4K(k)/\lambda` of the body angular momentum :math:`\mathbf M(t)`.
 
     Parameters
@@ -162,12 +168,12 @@ def momentum_period(inertia, M0) -> float:
     return T
 
 
-def tennis_racket_half_period(inertia, M0) -> float:
+def tennis_racket_half_period(inertia: ArrayLike, M0: ArrayLike) -> float:
     r"""Time :math:`2K(k)/\lambda` between consecutive flips (sign changes) of the momentum components that change sign."""
     return 0.5 * momentum_period(inertia, M0)
 
 
-def flip_times(traj, component: int = 1, *, refine: bool = True) -> np.ndarray:
+def flip_times(traj: Trajectory, component: int = 1, *, refine: bool = True) -> NDArray[np.float64]:
     r"""Times at which :math:`\Omega_\mathrm{component}(t)` changes sign.
 
     Sign changes between samples are located by linear interpolation and,
@@ -365,7 +371,7 @@ def _tumbling_one(I, V, name, is_omega):
     }
 
 
-def tumbling_periods(inertia, M0=None, *, omega0=None) -> dict:
+def tumbling_periods(inertia: ArrayLike, M0: ArrayLike | None = None, *, omega0: ArrayLike | None = None) -> dict:
     r"""The two fundamental periods of a tumbling (torque-free, non-principal-axis) body.
 
     With :math:`I_1<I_2<I_3` the principal moments sorted, :math:`L^2=|\mathbf M|^2`
@@ -544,7 +550,7 @@ def _family_rates(a, b, y, sam):
     return nu_psi, factor, k2, den
 
 
-def spin_states_from_periods(P_psi, P_phi, mode, *, I1_I3, I2_I3) -> dict:
+def spin_states_from_periods(P_psi: ArrayLike, P_phi: ArrayLike, mode: str, *, I1_I3: ArrayLike, I2_I3: ArrayLike) -> dict:
     r"""Spin states of a torque-free body with the periods :math:`P_\psi, P_\phi` in a given mode.
 
     The inverse of :func:`tumbling_periods`. A torque-free state is fixed, up
@@ -677,7 +683,7 @@ def spin_states_from_periods(P_psi, P_phi, mode, *, I1_I3, I2_I3) -> dict:
     for idx in np.ndindex(*shape):
         ai, bi = float(a[idx]), float(b[idx])
 
-        def g(y):
+        def g(y, ai=ai, bi=bi):
             nu_psi, factor, _, _ = _family_rates(ai, bi, y, sam)
             return float(np.log(nu_psi / factor)) - target
 
@@ -719,7 +725,7 @@ def _positive(x, name):
     return float(v)
 
 
-def sleeping_top(I1, I3, mass, ell, spin, g=9.81) -> dict:
+def sleeping_top(I1: float, I3: float, mass: float, ell: float, spin: float, g: float = 9.81) -> dict:
     r"""Stability of a sleeping top (Maxwell–Routh) and its small oscillations.
 
     A symmetric top (moments :math:`I_1 = I_2`, :math:`I_3` about the fixed
@@ -790,7 +796,7 @@ def sleeping_top(I1, I3, mass, ell, spin, g=9.81) -> dict:
             "fall_angle": float(np.arccos(a * a / (2.0 * mass * g * ell * I1) - 1.0))}
 
 
-def gravity_gradient_frequencies(moments, mean_motion) -> dict:
+def gravity_gradient_frequencies(moments: ArrayLike, mean_motion: float) -> dict:
     r"""Small oscillations of a satellite about its gravity-gradient equilibrium on a circular orbit.
 
     The principal axes of the satellite are aligned with the orbit frame:

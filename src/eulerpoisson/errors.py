@@ -12,26 +12,75 @@ __all__ = [
     "EulerPoissonError",
     "InvalidInputError",
     "InvalidInertiaError",
+    "UnsupportedModelError",
     "SingularChartError",
     "MissingDependencyError",
 ]
 
 
 class EulerPoissonError(Exception):
-    """Base class of every exception raised by eulerpoisson."""
+    """Base class of every exception raised by eulerpoisson.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> issubclass(ep.InvalidInputError, ep.EulerPoissonError), issubclass(ep.InvalidInputError, ValueError)
+    (True, True)
+    >>> try:
+    ...     ep.RigidBody([1.0, 2.0, 0.0])
+    ... except ep.EulerPoissonError as err:                           # every error of the package
+    ...     print(type(err).__name__)
+    InvalidInertiaError
+    """
 
 
 class InvalidInputError(EulerPoissonError, ValueError):
-    """An argument has the wrong shape, a non-finite value or an out-of-range value."""
+    """An argument has the wrong shape, a non-finite value or an out-of-range value.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> try:
+    ...     ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.1])
+    ... except ep.InvalidInputError as err:
+    ...     print(err)
+    omega0 must have shape (..., 3), got shape (2,)
+    >>> issubclass(ep.InvalidInputError, ValueError)
+    True
+    """
 
 
 class InvalidInertiaError(InvalidInputError):
     """An inertia tensor is not symmetric, not positive definite, or violates the
-    triangle inequalities ``I_i + I_j >= I_k`` of a physical body."""
+    triangle inequalities ``I_i + I_j >= I_k`` of a physical body.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> try:
+    ...     ep.RigidBody([3.0, 5.0, 9.0])                              # 3 + 5 < 9: no mass distribution
+    ... except ep.InvalidInertiaError as err:
+    ...     print(err)
+    inertia violates the triangle inequality I1 + I2 >= I3 of a physical body: principal moments [3.0, 5.0, 9.0] ...
+    >>> ep.RigidBody([3.0, 5.0, 9.0], allow_unphysical=True).kind
+    'asymmetric'
+    """
 
 
 class UnsupportedModelError(InvalidInputError):
-    """A solution method cannot run the model (its torques); the message names the methods that can."""
+    """A solution method cannot run the model (its torques); the message names the methods that can.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> def damping(t, q, omega):
+    ...     return -0.1 * omega
+    >>> try:
+    ...     ep.solve([1.0, 2.0, 2.5], [1.0], omega0=[1.0, 0.1, 0.5], torque=damping, method="taylor")
+    ... except ep.UnsupportedModelError as err:
+    ...     print(err)
+    method 'taylor' cannot run this model: ...; methods that can: rk
+    """
 
 
 class SingularChartError(EulerPoissonError, ValueError):
@@ -40,11 +89,35 @@ class SingularChartError(EulerPoissonError, ValueError):
     The global Gibbs vector ``n = k tan(alpha/2)`` is infinite at ``alpha = pi``
     (quaternion scalar part ``w = 0``). Use a quaternion or a local chart
     (:func:`eulerpoisson.attitude.gibbs_chart`) instead.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> a = ep.Attitude([0.0, 1.0, 0.0, 0.0])                        # 180 degrees about x
+    >>> try:
+    ...     a.as_gibbs()
+    ... except ep.SingularChartError as err:
+    ...     print(err)
+    the attitude has rotation angle alpha = pi (quaternion w = 0), where the global Gibbs vector
+    n = k tan(alpha/2) is infinite; ...
+    >>> print(a.as_chart([0.0, 1.0, 0.0, 0.0]))                      # a chart centred there: n = 0
+    [0. 0. 0.]
     """
 
 
 class MissingDependencyError(EulerPoissonError, ImportError):
-    """An optional dependency is not installed; the message names the extra."""
+    """An optional dependency is not installed; the message names the extra.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.errors import require
+    >>> try:
+    ...     require("no_such_module_here", "plot")
+    ... except ep.MissingDependencyError as err:
+    ...     print(err)
+    'no_such_module_here' is required for this feature; install it with pip install 'eulerpoisson[plot]'
+    """
 
 
 def require(module: str, extra: str):

@@ -21,6 +21,8 @@ The exact motion starts from the first sample (attitude and rate); see
 
 from __future__ import annotations
 
+from numpy.typing import ArrayLike
+
 from .oracle.cases import CASE_NAMES, ReferenceCase, reference_case, reference_cases
 from .oracle.compare import ValidationReport, compare_run
 from .oracle.runs import Conventions, run_from_arrays
@@ -28,8 +30,8 @@ from .oracle.runs import Conventions, run_from_arrays
 __all__ = ["assert_free_motion", "reference_cases", "reference_case", "ReferenceCase", "CASE_NAMES"]
 
 
-def assert_free_motion(t, q, omega, inertia, *, atol, quaternion_order="wxyz", omega_frame="body",
-                       attitude_convention="body-to-space", omega_rtol=None) -> ValidationReport:
+def assert_free_motion(t: ArrayLike, q: ArrayLike, omega: ArrayLike, inertia: ArrayLike, *, atol: float, quaternion_order: str = "wxyz", omega_frame: str = "body",
+                       attitude_convention: str = "body-to-space", omega_rtol: float | None = None) -> ValidationReport:
     r"""Assert that sampled attitudes and rates are the exact free motion from the first sample, within ``atol``.
 
     Parameters
@@ -70,6 +72,7 @@ def assert_free_motion(t, q, omega, inertia, *, atol, quaternion_order="wxyz", o
                       tolerance=atol)
     hint = f"; {rep.convention_hint}" if rep.convention_hint else ""
     if rep.verdict == "fail":
+        assert rep.exceeded_at is not None  # a failed verdict says when
         i = int(rep.t.searchsorted(rep.exceeded_at))
         raise AssertionError(
             f"not the exact free motion: the attitude error is {rep.attitude_error[i]:.3g} rad > atol = {atol:g} "

@@ -11,17 +11,27 @@ Trajectories are written to and read from NetCDF with CF-style attributes.
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
-from datetime import datetime, timezone
+from datetime import UTC, datetime
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from .io.atomic import atomic_path
-from .util.validate import as_float_array
 from .attitude.core import matrix_from_unit_quaternion, quaternion_make_continuous
+from .errors import EulerPoissonError, InvalidInputError, require
+from .io.atomic import atomic_path
 from .model.body import RigidBody
 from .model.equations import Model
-from .errors import EulerPoissonError, InvalidInputError, require
+from .util.validate import as_float_array
+
+if TYPE_CHECKING:
+    import xarray
+    from matplotlib.figure import Figure
+
+    from .io.read import LazyTrajectory
+    from .model.torques import TorqueLike
 
 __all__ = ["Trajectory", "FORMAT_VERSION"]
 
@@ -65,7 +75,7 @@ def _unit_continuous(t: np.ndarray, q: np.ndarray) -> np.ndarray:
     return np.take(qs, inv, axis=-2)
 
 
-def _stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
+def stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
     """What :class:`Trajectory` does to a solver's output, for part of a batch (the solve driver runs it in the
     thread that solved the part): ``quaternion`` and ``omega`` checked (finite, shapes), the quaternions
     returned as the trajectory stores them (:func:`_unit_continuous`).
@@ -89,9 +99,9 @@ class Trajectory:
     t : array_like, shape (T,)
         Output times, a 1-D array (``T = 0`` is allowed: an empty
         trajectory, whose :meth:`drift` raises).
-    quaternion : array_like, shape (*batch, T, 4)
+    quaternion : array_like, shape ``(*batch, T, 4)``
         Attitudes (made unit and sign-continuous in time here).
-    omega : array_like, shape (*batch, T, 3)
+    omega : array_like, shape ``(*batch, T, 3)``
         Body angular velocities.
     body : RigidBody
         One body, or a batch whose shape broadcasts to ``batch``.
@@ -125,12 +135,27 @@ class Trajectory:
     Derived quantities are properties computed on access: :attr:`matrix`,
     :attr:`gibbs` (NaN where the rotation angle is :math:`\pi`, flagged by
     :attr:`gibbs_singular`), :attr:`M`, :attr:`m`, :attr:`energy`.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> tr = ep.solve([1.0, 2.0, 2.5], np.linspace(0.0, 10.0, 101), omega0=[1.0, 0.1, 0.5])
+    >>> tr
+    Trajectory(method='exact', T=101, t=[0, 10])
+    >>> tr.quaternion.shape, tr.omega.shape, tr.matrix.shape
+    ((101, 4), (101, 3), (101, 3, 3))
+    >>> print(np.round(tr.omega[-1], 6))
+    [ 0.856743 -0.639521  0.192891]
+    >>> {k: bool(v < 1e-12) for k, v in tr.drift().items()}          # the integrals are conserved
+    {'energy': True, 'm_norm': True, 'm_x': True, 'm_y': True, 'm_z': True}
+    >>> print(tr[::50].t)                                            # index the samples
+    [ 0.  5. 10.]
     """
 
-    def __init__(self, t, quaternion, omega, body: RigidBody, method: str = "", options=None, stats=None, *,
-                 torque=None, _prepared: bool = False):
+    def __init__(self, t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, body: RigidBody, method: str = "", options: dict[str, Any] | None = None, stats: dict[str, Any] | None = None, *,
+                 torque: TorqueLike = None, _prepared: bool = False) -> None:
         # _prepared (private, for the solve driver): ``quaternion`` and ``omega`` are float64 arrays already
-        # checked and stored by :func:`_stored_attitudes` (chunk by chunk, in the threads that solved them)
+        # checked and stored by :func:`stored_attitudes` (chunk by chunk, in the threads that solved them)
         self.t = as_float_array(t, "t")
         if self.t.ndim != 1:
             raise InvalidInputError(f"t must be a 1-D array of output times, shape (T,); got shape {self.t.shape}")
@@ -187,41 +212,41 @@ class Trajectory:
         return self.body.inertia[..., None, :, :]
 
     @property
-    def matrix(self) -> np.ndarray:
-        """Rotation matrices R(t), (*batch, T, 3, 3)."""
+    def matrix(self) -> NDArray[np.float64]:
+        """Rotation matrices R(t), ``(*batch, T, 3, 3)``."""
         return matrix_from_unit_quaternion(self.quaternion)
 
     @property
-    def gibbs_singular(self) -> np.ndarray:
-        r"""Boolean mask (*batch, T): rotation angle exactly :math:`\pi`, where the global Gibbs vector is infinite."""
+    def gibbs_singular(self) -> NDArray[np.bool_]:
+        r"""Boolean mask ``(*batch, T)``: rotation angle exactly :math:`\pi`, where the global Gibbs vector is infinite."""
         return self.quaternion[..., 0] == 0
 
     @property
-    def gibbs(self) -> np.ndarray:
-        """Global Gibbs vectors n(t) = (x, y, z)/w, (*batch, T, 3); NaN where :attr:`gibbs_singular`."""
+    def gibbs(self) -> NDArray[np.float64]:
+        """Global Gibbs vectors n(t) = (x, y, z)/w, ``(*batch, T, 3)``; NaN where :attr:`gibbs_singular`."""
         w = self.quaternion[..., :1]
         with np.errstate(divide="ignore", invalid="ignore"):
             n = self.quaternion[..., 1:] / w
         return np.where(w == 0, np.nan, n)
 
     @property
-    def M(self) -> np.ndarray:
-        r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega`, (*batch, T, 3)."""
+    def M(self) -> NDArray[np.float64]:
+        r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega`, ``(*batch, T, 3)``."""
         return np.einsum("...ij,...j->...i", self._inertia, self.omega)
 
     @property
-    def m(self) -> np.ndarray:
-        r"""Spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`, (*batch, T, 3); constant for the free body."""
+    def m(self) -> NDArray[np.float64]:
+        r"""Spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`, ``(*batch, T, 3)``; constant for the free body."""
         return np.einsum("...ij,...j->...i", self.matrix, self.M)
 
     @property
-    def kinetic_energy(self) -> np.ndarray:
-        r"""Kinetic energy :math:`\tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega`, (*batch, T)."""
+    def kinetic_energy(self) -> NDArray[np.float64]:
+        r"""Kinetic energy :math:`\tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega`, ``(*batch, T)``."""
         return 0.5 * np.sum(self.omega * self.M, -1)
 
     @property
-    def potential_energy(self) -> np.ndarray:
-        r"""Potential energy :math:`U(t, R)` of the conservative torques, (*batch, T); 0 for the free body."""
+    def potential_energy(self) -> NDArray[np.float64]:
+        r"""Potential energy :math:`U(t, R)` of the conservative torques, ``(*batch, T)``; 0 for the free body."""
         if self.model.is_free:
             return np.zeros(self.omega.shape[:-1])
         T = self.t.shape[0]
@@ -234,8 +259,8 @@ class Trajectory:
         return np.moveaxis(U, 0, -1)
 
     @property
-    def energy(self) -> np.ndarray:
-        r"""Energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega + U`, (*batch, T).
+    def energy(self) -> NDArray[np.float64]:
+        r"""Energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega + U`, ``(*batch, T)``.
 
         The kinetic energy plus the potential of the conservative torques
         (:attr:`kinetic_energy`, :attr:`potential_energy`); the kinetic energy
@@ -245,8 +270,8 @@ class Trajectory:
             return self.kinetic_energy
         return self.kinetic_energy + self.potential_energy
 
-    def integrals(self) -> dict[str, np.ndarray]:
-        """The conserved quantities of the trajectory's model at every output time, each (*batch, T).
+    def integrals(self) -> dict[str, NDArray[np.float64]]:
+        """The conserved quantities of the trajectory's model at every output time, each ``(*batch, T)``.
 
         See :meth:`eulerpoisson.Model.integrals` for which ones (energy and
         spatial angular momentum for the free body; energy, vertical angular
@@ -255,7 +280,7 @@ class Trajectory:
         """
         return self.model.integrals(self.t, self.quaternion, self.omega)
 
-    def drift(self) -> dict[str, np.ndarray]:
+    def drift(self) -> dict[str, NDArray[np.float64]]:
         r"""Relative drift of every integral of motion of the model over the trajectory.
 
         Relative to the value at the first output time ``t[0]`` (the
@@ -295,7 +320,7 @@ class Trajectory:
         acc.update(self.t, self.quaternion, self.omega)
         return acc.result()
 
-    def particles(self, center0=(0.0, 0.0, 0.0), velocity0=(0.0, 0.0, 0.0)) -> np.ndarray:
+    def particles(self, center0: ArrayLike = (0.0, 0.0, 0.0), velocity0: ArrayLike = (0.0, 0.0, 0.0)) -> NDArray[np.float64]:
         r"""Positions of the body's point masses, :math:`\mathbf y_N(t) = \mathbf C_0 + \mathbf V_0 t + R(t)\mathbf x_N(0)` (paper eq. 1.2).
 
         Parameters
@@ -309,7 +334,7 @@ class Trajectory:
 
         Returns
         -------
-        ndarray, shape (*batch, T, N, 3)
+        ndarray, shape ``(*batch, T, N, 3)``
 
         Raises
         ------
@@ -327,7 +352,7 @@ class Trajectory:
         return y + C0 + V0 * self.t[:, None, None]
 
     # ------------------------------------------------------------------
-    def to_xarray(self):
+    def to_xarray(self) -> xarray.Dataset:
         """The trajectory as an :class:`xarray.Dataset` with CF-style attributes.
 
         Batches are flattened to a ``body`` dimension (the batch shape is kept
@@ -401,12 +426,12 @@ class Trajectory:
             "batch_shape": json.dumps(list(bshape)),
             "body_name": self.body.name or "",
             "T": T,
-            "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} written by eulerpoisson {__version__}",
+            "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} written by eulerpoisson {__version__}",
             "references": "A. A. Deriglazov, Geodesic motion on the symplectic leaf of SO(3) ... (the paper)",
         }
         return data, coords, attrs
 
-    def to_netcdf(self, path) -> None:
+    def to_netcdf(self, path: str | os.PathLike[str]) -> None:
         """Write the trajectory to a NetCDF-4 file, atomically (temporary file, then rename).
 
         Raises
@@ -458,7 +483,7 @@ class Trajectory:
                 raise write_error(path, exc) from None
 
     @classmethod
-    def from_netcdf(cls, path) -> "Trajectory":
+    def from_netcdf(cls, path: str | os.PathLike[str]) -> Trajectory:
         """Read a trajectory written by :meth:`to_netcdf`.
 
         Parameters
@@ -497,6 +522,8 @@ class Trajectory:
 
         if not isinstance(path, (str, bytes, os.PathLike)):
             raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
+        if isinstance(path, bytes):
+            path = os.fsdecode(path)  # named as text in the messages below, not b'...'
         xr = require("xarray", "io")
         if not os.path.exists(path):
             raise FileNotFoundError(f"no such file: {path}")
@@ -509,7 +536,7 @@ class Trajectory:
         ver = ds.attrs.get("eulerpoisson_format_version")
         if ver is None or "quaternion" not in ds or "omega" not in ds:
             raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory file")
-        ver = _format_version(path, ver)
+        ver = format_version(path, ver)
         if ver > FORMAT_VERSION:
             raise EulerPoissonError(
                 f"{path} has format version {ver}, newer than this eulerpoisson "
@@ -524,14 +551,14 @@ class Trajectory:
                 f"{path}: malformed eulerpoisson trajectory file, variable(s) {missing} missing "
                 f"(expected {need} besides quaternion and omega)"
             )
-        bshape = _json_attr(path, ds, "batch_shape", "[]", list)
+        bshape = json_attr(path, ds, "batch_shape", "[]", list)
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
             raise InvalidInputError(
                 f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}"
             )
         bshape = tuple(bshape)
-        options = _json_attr(path, ds, "method_options", "{}", dict)
-        stats = _json_attr(path, ds, "stats", "{}", dict)
+        options = json_attr(path, ds, "method_options", "{}", dict)
+        stats = json_attr(path, ds, "stats", "{}", dict)
         t = ds["time"].values
         q = ds["quaternion"].values
         w = ds["omega"].values
@@ -582,7 +609,7 @@ class Trajectory:
                 method=str(ds.attrs.get("method", "")),
                 options=options,
                 stats=stats,
-                torque=_read_torques(path, ds),
+                torque=read_torques(path, ds),
             )
         except (InvalidInputError, TypeError) as exc:  # name the file (the type is kept)
             raise type(exc)(f"{path}: {exc}") from exc
@@ -602,7 +629,7 @@ class Trajectory:
         return traj
 
     @classmethod
-    def open(cls, path):
+    def open(cls, path: str | os.PathLike[str]) -> Trajectory | LazyTrajectory:
         """Open a trajectory file of any format eulerpoisson writes, by its content.
 
         NetCDF-4 (:meth:`to_netcdf`) and NetCDF-3 classic files are read into
@@ -625,7 +652,7 @@ class Trajectory:
     # ------------------------------------------------------------------
     # selecting and evaluating
     # ------------------------------------------------------------------
-    def __getitem__(self, index) -> "Trajectory":
+    def __getitem__(self, index: Any) -> Trajectory:
         """The samples ``index`` (an int, a slice, an integer or boolean array) of the time axis.
 
         ``len(tr)`` is the number of output times and ``tr[i]`` the trajectory
@@ -648,7 +675,7 @@ class Trajectory:
         return Trajectory(self.t[idx], self.quaternion[..., idx, :], self.omega[..., idx, :], self.body,
                           self.method, self.options, self.stats, torque=list(self.model.torques))
 
-    def sel(self, t, method: str | None = None) -> "Trajectory":
+    def sel(self, t: ArrayLike, method: str | None = None) -> Trajectory:
         """The samples at the output times ``t`` (exact match, or ``method="nearest"``).
 
         Parameters
@@ -681,7 +708,7 @@ class Trajectory:
                            f"or evaluate it with tr({bad!r})")
         return self[order[pick]]
 
-    def __call__(self, t, **options) -> "Trajectory":
+    def __call__(self, t: ArrayLike, **options: Any) -> Trajectory:
         r"""The motion at any times ``t``: recomputed from the first sample by the trajectory's method.
 
         The closed form (``exact``) evaluates the same solution at the new
@@ -716,7 +743,7 @@ class Trajectory:
         return solve_from(self.model, times, float(self.t[i0]), self.quaternion[..., i0, :], self.omega[..., i0, :],
                           method=method, **opts)
 
-    def plot(self, kind: str = "omega", **kwargs):
+    def plot(self, kind: str = "omega", **kwargs: Any) -> Figure:
         """A picture of the trajectory: :func:`eulerpoisson.viz.plots.plot` (``kind``: omega, invariants,
         polhode, gibbs, attitude, apex); returns the matplotlib figure (or writes ``out=`` when given)."""
         from .viz import plots
@@ -727,6 +754,15 @@ class Trajectory:
         b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
         span = f"[{self.t.min():.6g}, {self.t.max():.6g}]" if self.t.size else "[]"
         return f"Trajectory(method={self.method!r}, T={len(self.t)}, t={span}{b})"
+
+    def _repr_html_(self) -> str:
+        """A compact HTML table and a small inline SVG picture of Ω(t) and of the energy, for notebooks.
+
+        See :func:`eulerpoisson.util.htmlrepr.trajectory_html` (no matplotlib; decimated, a few kB at any length).
+        """
+        from .util.htmlrepr import trajectory_html
+
+        return trajectory_html(self)
 
 
 def _torque_records(torques) -> list[dict]:
@@ -740,9 +776,9 @@ def _torque_records(torques) -> list[dict]:
     return out
 
 
-def _read_torques(path, ds):
+def read_torques(path, ds):
     """The torques of a file's ``torque`` attribute (absent: the free body)."""
-    from .model.torques import UnrecordedTorque, torque_from_dict
+    from .model.torques import Torque, UnrecordedTorque, torque_from_dict
 
     raw = ds.attrs.get("torque")
     if raw is None or raw == "":
@@ -753,7 +789,7 @@ def _read_torques(path, ds):
         raise InvalidInputError(f"{path}: the torque attribute is not valid JSON: {str(raw)[:80]!r}") from None
     if not isinstance(records, list):
         raise InvalidInputError(f"{path}: the torque attribute must be a JSON list of records, got {str(raw)[:80]!r}")
-    out = []
+    out: list[Torque] = []
     for rec in records:
         if isinstance(rec, dict) and rec.get("kind") == "unrecorded":
             out.append(UnrecordedTorque(str(rec.get("description", ""))))
@@ -765,7 +801,7 @@ def _read_torques(path, ds):
     return out
 
 
-def _format_version(path, ver) -> int:
+def format_version(path, ver) -> int:
     """The ``eulerpoisson_format_version`` attribute as a positive int, or InvalidInputError."""
     v = ver.item() if isinstance(ver, np.ndarray) and ver.size == 1 else ver
     if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < 1:
@@ -775,7 +811,7 @@ def _format_version(path, ver) -> int:
     return int(v)
 
 
-def _json_attr(path, ds, key: str, default: str, kind: type):
+def json_attr(path, ds, key: str, default: str, kind: type):
     """Decode the JSON attribute ``key`` (a ``kind``: list or dict), or InvalidInputError naming the file."""
     raw = ds.attrs.get(key, default)
     try:

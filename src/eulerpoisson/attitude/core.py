@@ -65,14 +65,23 @@ precision", Numer. Math. 18 (1971) 224-242.
 from __future__ import annotations
 
 import operator
+from collections.abc import Iterator
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
+from ..errors import InvalidInputError, SingularChartError
 from ..numerics.doubledouble import sum_of_squares as _sumsq_dd
 from ..numerics.doubledouble import two_prod as _two_prod
 from ..numerics.quaternion import qmul
 from ..util.validate import as_bool, as_float_array, as_scalar, as_shape, check_broadcast
-from ..errors import InvalidInputError, SingularChartError
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
+
+#: an attitude as the API takes it: an :class:`Attitude`, a scipy ``Rotation`` or unit quaternions (w, x, y, z)
+AttitudeLike: TypeAlias = "Attitude | Rotation | ArrayLike"
 
 __all__ = [
     "Attitude",
@@ -129,7 +138,7 @@ _CONJ = np.array([1.0, -1.0, -1.0, -1.0])
 #: cosine) of the half middle angle is below this fraction of the other; the
 #: rotation error introduced by zeroing the third angle is at most about
 #: twice this value.
-#: largest | |q| - 1 | accepted where a unit quaternion is required (a float32-rounded unit quaternion is
+#: largest ``| |q| - 1 |`` accepted where a unit quaternion is required (a float32-rounded unit quaternion is
 #: off by about 3e-8); inputs within it are renormalized, inputs beyond it are refused
 UNIT_QUATERNION_TOLERANCE = 1e-6
 
@@ -139,7 +148,7 @@ EULER_GIMBAL_TOL = 1e-14
 # ---------------------------------------------------------------------------
 # small helpers
 # ---------------------------------------------------------------------------
-def skew(v) -> np.ndarray:
+def skew(v: ArrayLike) -> NDArray[np.float64]:
     r"""Cross-product matrix :math:`[\mathbf v]_\times`, with :math:`[\mathbf v]_\times \mathbf w = \mathbf v\times\mathbf w`.
 
     In the paper's index notation :math:`([\mathbf v]_\times)_{ij} = -\epsilon_{ijk} v_k`
@@ -157,6 +166,18 @@ def skew(v) -> np.ndarray:
     ------
     InvalidInputError
         Wrong trailing shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import skew
+    >>> S = skew([1.0, 2.0, 3.0])
+    >>> print(S)
+    [[ 0. -3.  2.]
+     [ 3.  0. -1.]
+     [-2.  1.  0.]]
+    >>> print(S @ [0.0, 0.0, 1.0], np.cross([1.0, 2.0, 3.0], [0.0, 0.0, 1.0]))
+    [ 2. -1.  0.] [ 2. -1.  0.]
     """
     v = as_float_array(v, "v", (3,))
     return _skew(v)
@@ -170,7 +191,7 @@ def _skew(v: np.ndarray) -> np.ndarray:
     )
 
 
-def unskew(S) -> np.ndarray:
+def unskew(S: ArrayLike) -> NDArray[np.float64]:
     r"""Vector of the antisymmetric part of ``S``: the inverse of :func:`skew`.
 
     .. math:: v_k = -\tfrac12\epsilon_{kij}S_{ij}
@@ -189,6 +210,12 @@ def unskew(S) -> np.ndarray:
     ------
     InvalidInputError
         Wrong trailing shape or non-finite values.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import skew, unskew
+    >>> print(unskew(skew([1.0, 2.0, 3.0])))
+    [1. 2. 3.]
     """
     S = as_float_array(S, "S", (3, 3))
     return 0.5 * np.stack(
@@ -243,7 +270,7 @@ def as_quaternion(q, name="q") -> np.ndarray:
     return qs / _norm(qs)[..., None]
 
 
-def quaternion_multiply(p, q) -> np.ndarray:
+def quaternion_multiply(p: ArrayLike, q: ArrayLike) -> NDArray[np.float64]:
     r"""Hamilton product :math:`p\otimes q` of scalar-first quaternions.
 
     .. math:: (p_0, \mathbf p)\otimes(q_0, \mathbf q) =
@@ -266,6 +293,14 @@ def quaternion_multiply(p, q) -> np.ndarray:
     ------
     InvalidInputError
         Wrong trailing shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_multiply
+    >>> qz = [np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)]     # 90 degrees about z
+    >>> print(np.round(quaternion_multiply(qz, qz), 12))          # 180 degrees about z
+    [0. 0. 0. 1.]
     """
     p = as_float_array(p, "p", (4,))
     q = as_float_array(q, "q", (4,))
@@ -275,7 +310,7 @@ def quaternion_multiply(p, q) -> np.ndarray:
     return finite_result(out, "quaternion_multiply", p=p, q=q)
 
 
-def quaternion_conjugate(q) -> np.ndarray:
+def quaternion_conjugate(q: ArrayLike) -> NDArray[np.float64]:
     """Conjugate ``(w, -x, -y, -z)``: the inverse rotation of a unit quaternion.
 
     Parameters
@@ -291,12 +326,21 @@ def quaternion_conjugate(q) -> np.ndarray:
     ------
     InvalidInputError
         Wrong trailing shape or non-finite values.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import quaternion_conjugate, quaternion_multiply
+    >>> q = [0.5, 0.5, 0.5, 0.5]
+    >>> print(quaternion_conjugate(q))
+    [ 0.5 -0.5 -0.5 -0.5]
+    >>> print(quaternion_multiply(q, quaternion_conjugate(q)))    # the identity
+    [1. 0. 0. 0.]
     """
     q = as_float_array(q, "q", (4,))
     return q * _CONJ
 
 
-def quaternion_normalize(q) -> np.ndarray:
+def quaternion_normalize(q: ArrayLike) -> NDArray[np.float64]:
     """Scale quaternions to unit norm (without overflow or underflow).
 
     Parameters
@@ -311,11 +355,19 @@ def quaternion_normalize(q) -> np.ndarray:
     ------
     InvalidInputError
         Zero quaternion, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import quaternion_normalize
+    >>> print(quaternion_normalize([3.0, 0.0, 4.0, 0.0]))
+    [0.6 0.  0.8 0. ]
+    >>> print(quaternion_normalize([3e300, 0.0, 4e300, 0.0]))     # no overflow
+    [0.6 0.  0.8 0. ]
     """
     return as_quaternion(q)
 
 
-def quaternion_canonical(q) -> np.ndarray:
+def quaternion_canonical(q: ArrayLike) -> NDArray[np.float64]:
     """Unit quaternion with the sign chosen so that ``w >= 0``.
 
     For ``w = 0`` the first nonzero vector component is made positive, so the
@@ -333,17 +385,23 @@ def quaternion_canonical(q) -> np.ndarray:
     ------
     InvalidInputError
         Zero quaternion, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import quaternion_canonical
+    >>> print(quaternion_canonical([-0.5, -0.5, 0.5, -0.5]))     # the same rotation, w >= 0
+    [ 0.5  0.5 -0.5  0.5]
     """
     return _canonical(as_quaternion(q))
 
 
-def _canonical(q):
+def _canonical(q: np.ndarray) -> np.ndarray:
     first = np.argmax(q != 0, axis=-1)
     lead = np.take_along_axis(q, first[..., None], axis=-1)
     return np.where(lead < 0, -q, q)
 
 
-def quaternion_make_continuous(q, axis: int = 0) -> np.ndarray:
+def quaternion_make_continuous(q: ArrayLike, axis: int = 0) -> NDArray[np.float64]:
     """Flip signs along ``axis`` so that consecutive quaternions have a nonnegative dot product.
 
     Both ``q`` and ``-q`` are the same rotation; a time series of attitudes
@@ -368,6 +426,15 @@ def quaternion_make_continuous(q, axis: int = 0) -> np.ndarray:
         the quaternion axis.
     TypeError
         If ``axis`` is not an integer.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import quaternion_make_continuous
+    >>> q = [[1.0, 0.0, 0.0, 0.0], [-0.8, -0.6, 0.0, 0.0], [0.6, 0.8, 0.0, 0.0]]
+    >>> print(quaternion_make_continuous(q)[:, :2])               # (w, x): the second sample flipped
+    [[1.  0. ]
+     [0.8 0.6]
+     [0.6 0.8]]
     """
     q = as_float_array(q, "q", (4,))
     try:
@@ -390,7 +457,7 @@ def quaternion_make_continuous(q, axis: int = 0) -> np.ndarray:
     return np.moveaxis(qm * sign[..., None], 0, ax)
 
 
-def matrix_from_quaternion(q) -> np.ndarray:
+def matrix_from_quaternion(q: ArrayLike) -> NDArray[np.float64]:
     r"""Rotation matrix of a quaternion.
 
     .. math:: R = (w^2-\mathbf v^2)\mathbf 1 + 2\mathbf v\mathbf v^T + 2w[\mathbf v]_\times
@@ -413,6 +480,14 @@ def matrix_from_quaternion(q) -> np.ndarray:
     References
     ----------
     Paper, footnote to eq. 1.9 (with :math:`\mathbf n = \mathbf q/q_0` this is eq. 1.9).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import matrix_from_quaternion
+    >>> R = matrix_from_quaternion([np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)])   # 90 degrees about z
+    >>> print(np.round(R @ [1.0, 0.0, 0.0], 12) + 0.0)            # x_space = R x_body
+    [0. 1. 0.]
     """
     return matrix_from_unit_quaternion(as_quaternion(q))
 
@@ -424,7 +499,7 @@ def matrix_from_unit_quaternion(q):
     return R + 2.0 * _outer(v, v) + 2.0 * w[..., None, None] * _skew(v)
 
 
-def quaternion_from_matrix(R, *, atol: float = 1e-6) -> np.ndarray:
+def quaternion_from_matrix(R: ArrayLike, *, atol: float = 1e-6) -> NDArray[np.float64]:
     r"""Unit quaternion (``w >= 0``) of a rotation matrix, by Shepperd's method.
 
     The largest of :math:`4w^2 = 1+\mathrm{tr}R` and
@@ -458,6 +533,14 @@ def quaternion_from_matrix(R, *, atol: float = 1e-6) -> np.ndarray:
     References
     ----------
     Shepperd (1978).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_matrix
+    >>> R = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]  # 90 degrees about z
+    >>> print(np.round(quaternion_from_matrix(R), 12))
+    [0.70710678 0.         0.         0.70710678]
     """
     R = as_float_array(R, "R", (3, 3))
     atol = as_scalar(atol, "atol", nonnegative=True)
@@ -503,7 +586,7 @@ def quaternion_from_rotation_matrix(R):
 # ---------------------------------------------------------------------------
 # Gibbs vector (the paper's n)
 # ---------------------------------------------------------------------------
-def quaternion_from_gibbs(n) -> np.ndarray:
+def quaternion_from_gibbs(n: ArrayLike) -> NDArray[np.float64]:
     r"""Unit quaternion (``w > 0``) of a Gibbs vector.
 
     .. math:: q = \frac{(1, \mathbf n)}{\sqrt{1+\mathbf n^2}}
@@ -530,6 +613,13 @@ def quaternion_from_gibbs(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.8 and the footnote to eq. 1.9.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_gibbs
+    >>> print(np.round(quaternion_from_gibbs([0.0, 0.0, 1.0]), 12))   # tan(45 deg): 90 degrees about z
+    [0.70710678 0.         0.         0.70710678]
     """
     n = as_float_array(n, "n", (3,))
     return _quaternion_from_gibbs(n)
@@ -563,7 +653,7 @@ def _gibbs_from_unit_quaternion(q, what="the attitude"):
     return n
 
 
-def gibbs_from_quaternion(q) -> np.ndarray:
+def gibbs_from_quaternion(q: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector :math:`\mathbf n = (x, y, z)/w` of a quaternion.
 
     The result does not depend on the sign or the norm of ``q``; it has a
@@ -588,11 +678,22 @@ def gibbs_from_quaternion(q) -> np.ndarray:
     References
     ----------
     Paper, footnote to eq. 1.9, and eq. 1.8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_from_quaternion
+    >>> print(gibbs_from_quaternion([0.5, 0.5, 0.0, 0.0]))        # n = (x, y, z) / w
+    [1. 0. 0.]
+    >>> gibbs_from_quaternion([0.0, 1.0, 0.0, 0.0])               # 180 degrees: n is infinite
+    Traceback (most recent call last):
+        ...
+    eulerpoisson.errors.SingularChartError: the attitude has rotation angle alpha = pi (quaternion w = 0), ...
     """
     return _gibbs_from_unit_quaternion(as_quaternion(q))
 
 
-def matrix_from_gibbs(n) -> np.ndarray:
+def matrix_from_gibbs(n: ArrayLike) -> NDArray[np.float64]:
     r"""The paper's rotation matrix :math:`R(\mathbf n)` (eq. 1.9).
 
     .. math::
@@ -619,12 +720,21 @@ def matrix_from_gibbs(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.9 (equivalently eq. 1.7 with eq. 1.8).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import matrix_from_gibbs
+    >>> print(np.round(matrix_from_gibbs([0.0, 0.0, 1.0]), 12) + 0.0)   # 90 degrees about z
+    [[ 0. -1.  0.]
+     [ 1.  0.  0.]
+     [ 0.  0.  1.]]
     """
     n = as_float_array(n, "n", (3,))
     return matrix_from_unit_quaternion(_quaternion_from_gibbs(n))
 
 
-def gibbs_from_matrix(R, *, atol: float = 1e-6) -> np.ndarray:
+def gibbs_from_matrix(R: ArrayLike, *, atol: float = 1e-6) -> NDArray[np.float64]:
     r"""Gibbs vector of a rotation matrix (through Shepperd's quaternion).
 
     Near :math:`\alpha=\pi` the relative accuracy of :math:`\mathbf n` is
@@ -651,6 +761,14 @@ def gibbs_from_matrix(R, *, atol: float = 1e-6) -> np.ndarray:
     References
     ----------
     Paper eq. 1.9 inverted; Shepperd (1978).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_from_matrix
+    >>> R = [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]  # 90 degrees about x
+    >>> print(np.round(gibbs_from_matrix(R), 12) + 0.0)
+    [1. 0. 0.]
     """
     return _gibbs_from_unit_quaternion(quaternion_from_matrix(R, atol=atol), "R")
 
@@ -669,7 +787,7 @@ def _unit_axis(axis, name="axis"):
     return k / _norm(k)[..., None]
 
 
-def quaternion_from_axis_angle(axis, angle) -> np.ndarray:
+def quaternion_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     r"""Quaternion :math:`(\cos\frac\alpha2, \mathbf k\sin\frac\alpha2)` of a rotation by ``angle`` about ``axis``.
 
     Parameters
@@ -692,6 +810,13 @@ def quaternion_from_axis_angle(axis, angle) -> np.ndarray:
     References
     ----------
     Paper eq. 1.7; Shuster (1993), section 5.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_axis_angle
+    >>> print(np.round(quaternion_from_axis_angle([0.0, 0.0, 2.0], np.pi / 2), 12))   # the axis is normalized
+    [0.70710678 0.         0.         0.70710678]
     """
     k = _unit_axis(axis)
     a = as_float_array(angle, "angle")
@@ -707,7 +832,7 @@ def quaternion_from_axis_angle(axis, angle) -> np.ndarray:
     return np.concatenate([np.cos(a / 2)[..., None], k * np.sin(a / 2)[..., None]], -1)
 
 
-def axis_angle_from_quaternion(q) -> tuple[np.ndarray, np.ndarray]:
+def axis_angle_from_quaternion(q: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     r"""Unit axis :math:`\mathbf k` and angle :math:`\alpha\in[0,\pi]` of a quaternion.
 
     :math:`\alpha = 2\,\mathrm{atan2}(|\mathbf v|, |w|)`, accurate at every
@@ -727,6 +852,14 @@ def axis_angle_from_quaternion(q) -> tuple[np.ndarray, np.ndarray]:
     ------
     InvalidInputError
         Zero quaternion, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import axis_angle_from_quaternion
+    >>> k, alpha = axis_angle_from_quaternion([0.5, 0.5, 0.5, 0.5])
+    >>> print(np.round(k, 6), round(float(np.degrees(alpha)), 9))
+    [0.57735 0.57735 0.57735] 120.0
     """
     q = _canonical(as_quaternion(q))
     v = q[..., 1:]
@@ -737,7 +870,7 @@ def axis_angle_from_quaternion(q) -> tuple[np.ndarray, np.ndarray]:
     return axis, angle
 
 
-def quaternion_from_rotvec(rotvec) -> np.ndarray:
+def quaternion_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     r"""Quaternion of a rotation vector :math:`\boldsymbol\phi = \alpha\mathbf k` (scipy's ``rotvec``).
 
     .. math:: q = \left(\cos\frac\alpha2,\; \frac{\sin(\alpha/2)}{\alpha}\boldsymbol\phi\right)
@@ -765,6 +898,13 @@ def quaternion_from_rotvec(rotvec) -> np.ndarray:
     References
     ----------
     Shuster (1993), section 5.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_rotvec
+    >>> print(np.round(quaternion_from_rotvec([0.0, np.pi, 0.0]), 12) + 0.0)   # 180 degrees about y
+    [0. 0. 1. 0.]
     """
     r = as_float_array(rotvec, "rotvec", (3,))
     m = np.max(np.abs(r), axis=-1)
@@ -785,7 +925,7 @@ def quaternion_from_rotvec(rotvec) -> np.ndarray:
     return np.concatenate([w[..., None], v], -1)
 
 
-def rotvec_from_quaternion(q) -> np.ndarray:
+def rotvec_from_quaternion(q: ArrayLike) -> NDArray[np.float64]:
     r"""Rotation vector :math:`\alpha\mathbf k`, :math:`\alpha\in[0,\pi]`, of a quaternion.
 
     .. math:: \boldsymbol\phi = \frac{\alpha}{\sin(\alpha/2)}\mathbf v,
@@ -803,6 +943,13 @@ def rotvec_from_quaternion(q) -> np.ndarray:
     ------
     InvalidInputError
         Zero quaternion, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import rotvec_from_quaternion
+    >>> print(np.round(rotvec_from_quaternion([np.cos(0.25), 0.0, 0.0, np.sin(0.25)]), 12) + 0.0)   # 0.5 rad about z
+    [0.  0.  0.5]
     """
     q = _canonical(as_quaternion(q))
     s = _norm(q[..., 1:])
@@ -810,7 +957,7 @@ def rotvec_from_quaternion(q) -> np.ndarray:
     return q[..., 1:] * (2.0 / np.sinc(th / (2 * np.pi)))[..., None]
 
 
-def quaternion_from_mrp(p) -> np.ndarray:
+def quaternion_from_mrp(p: ArrayLike) -> NDArray[np.float64]:
     r"""Quaternion of modified Rodrigues parameters :math:`\mathbf p = \mathbf k\tan(\alpha/4)`.
 
     .. math:: q = \frac{(1-\mathbf p^2,\; 2\mathbf p)}{1+\mathbf p^2}
@@ -836,6 +983,14 @@ def quaternion_from_mrp(p) -> np.ndarray:
     References
     ----------
     Shuster (1993), section 9.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_mrp
+    >>> p = [0.0, 0.0, np.tan(np.pi / 8)]                         # k tan(alpha/4), 90 degrees about z
+    >>> print(np.round(quaternion_from_mrp(p), 12))
+    [0.70710678 0.         0.         0.70710678]
     """
     p = as_float_array(p, "p", (3,))
     m = np.max(np.abs(p), axis=-1)
@@ -859,7 +1014,7 @@ def quaternion_from_mrp(p) -> np.ndarray:
     return np.concatenate([w[..., None], v], -1)
 
 
-def mrp_from_quaternion(q) -> np.ndarray:
+def mrp_from_quaternion(q: ArrayLike) -> NDArray[np.float64]:
     r"""Modified Rodrigues parameters :math:`\mathbf v/(1+w)` with ``w >= 0`` (so :math:`|\mathbf p|\le 1`).
 
     Parameters
@@ -878,6 +1033,13 @@ def mrp_from_quaternion(q) -> np.ndarray:
     References
     ----------
     Shuster (1993), section 9.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import mrp_from_quaternion
+    >>> print(np.round(mrp_from_quaternion([0.0, 1.0, 0.0, 0.0]), 12))   # 180 degrees: |p| = 1
+    [1. 0. 0.]
     """
     q = _canonical(as_quaternion(q))
     return q[..., 1:] / (1.0 + q[..., :1])
@@ -889,7 +1051,7 @@ def mrp_from_quaternion(q) -> np.ndarray:
 _AXES = {"x": 0, "y": 1, "z": 2}
 
 
-def _parse_seq(seq):
+def parse_seq(seq):
     if not isinstance(seq, str) or len(seq) != 3:
         raise InvalidInputError(
             f"seq must be a 3-letter axis sequence such as 'xyz' (extrinsic) or 'ZYX' (intrinsic), got {seq!r}"
@@ -910,7 +1072,7 @@ def _parse_seq(seq):
     return [_AXES[c] for c in s], intrinsic
 
 
-def quaternion_from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
+def quaternion_from_euler(seq: str, angles: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
     r"""Quaternion from Euler angles in any of the 12 sequences.
 
     Lower-case ``seq`` (``"xyz"``) is extrinsic: rotations about the fixed
@@ -935,8 +1097,15 @@ def quaternion_from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndar
     ------
     InvalidInputError
         Invalid sequence, wrong shape or non-finite angles.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import quaternion_from_euler
+    >>> print(np.round(quaternion_from_euler("ZYX", [90.0, 0.0, 0.0], degrees=True), 12))   # yaw 90 degrees
+    [0.70710678 0.         0.         0.70710678]
     """
-    axes, intrinsic = _parse_seq(seq)
+    axes, intrinsic = parse_seq(seq)
     ang = as_float_array(angles, "angles", (3,))
     if as_bool(degrees, "degrees"):
         ang = np.deg2rad(ang)
@@ -957,7 +1126,7 @@ def _wrap_pi(x):
     return np.where(x > np.pi, x - 2 * np.pi, np.where(x <= -np.pi, x + 2 * np.pi, x))
 
 
-def euler_from_quaternion(seq: str, q, *, degrees: bool = False) -> np.ndarray:
+def euler_from_quaternion(seq: str, q: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
     r"""Euler angles of a quaternion in any of the 12 sequences.
 
     Direct method of Bernardes & Viollet (2022), with the Tait-Bryan middle
@@ -995,8 +1164,16 @@ def euler_from_quaternion(seq: str, q, *, degrees: bool = False) -> np.ndarray:
     References
     ----------
     Bernardes and Viollet (2022).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import euler_from_quaternion, quaternion_from_euler
+    >>> q = quaternion_from_euler("ZYX", [30.0, 20.0, 10.0], degrees=True)
+    >>> print(np.round(euler_from_quaternion("ZYX", q, degrees=True), 9))
+    [30. 20. 10.]
     """
-    axes, intrinsic = _parse_seq(seq)
+    axes, intrinsic = parse_seq(seq)
     q = as_quaternion(q)
     if intrinsic:
         axes = axes[::-1]  # intrinsic abc == extrinsic cba with reversed angles
@@ -1041,7 +1218,7 @@ def euler_from_quaternion(seq: str, q, *, degrees: bool = False) -> np.ndarray:
 # ---------------------------------------------------------------------------
 # scipy
 # ---------------------------------------------------------------------------
-def quaternion_from_scipy(rotation) -> np.ndarray:
+def quaternion_from_scipy(rotation: Rotation) -> NDArray[np.float64]:
     """Scalar-first unit quaternions of a :class:`scipy.spatial.transform.Rotation`.
 
     Parameters
@@ -1057,6 +1234,14 @@ def quaternion_from_scipy(rotation) -> np.ndarray:
     ------
     TypeError
         If ``rotation`` is not a scipy ``Rotation``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from scipy.spatial.transform import Rotation
+    >>> from eulerpoisson.attitude import quaternion_from_scipy
+    >>> print(np.round(quaternion_from_scipy(Rotation.from_rotvec([0.0, 0.0, np.pi / 2])), 12))   # scalar first
+    [0.70710678 0.         0.         0.70710678]
     """
     from scipy.spatial.transform import Rotation
 
@@ -1065,7 +1250,7 @@ def quaternion_from_scipy(rotation) -> np.ndarray:
     return np.roll(np.asarray(rotation.as_quat(), dtype=float), 1, axis=-1)
 
 
-def scipy_from_quaternion(q):
+def scipy_from_quaternion(q: ArrayLike) -> Rotation:
     """A :class:`scipy.spatial.transform.Rotation` of scalar-first quaternions.
 
     Parameters
@@ -1083,6 +1268,14 @@ def scipy_from_quaternion(q):
     InvalidInputError
         Zero quaternion, wrong shape, non-finite values, or a multi-axis batch
         that the installed scipy cannot hold.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import scipy_from_quaternion
+    >>> r = scipy_from_quaternion([np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)])
+    >>> print(np.round(r.as_quat(), 12))                           # scipy's order is scalar last
+    [0.         0.         0.70710678 0.70710678]
     """
     from scipy.spatial.transform import Rotation
 
@@ -1102,7 +1295,7 @@ def scipy_from_quaternion(q):
 # ---------------------------------------------------------------------------
 # Gibbs <-> everything
 # ---------------------------------------------------------------------------
-def gibbs_from_axis_angle(axis, angle) -> np.ndarray:
+def gibbs_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector :math:`\mathbf k\tan(\alpha/2)` (paper eq. 1.8).
 
     Parameters
@@ -1127,11 +1320,18 @@ def gibbs_from_axis_angle(axis, angle) -> np.ndarray:
     References
     ----------
     Paper eq. 1.8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_from_axis_angle
+    >>> print(np.round(gibbs_from_axis_angle([1.0, 0.0, 0.0], 2 * np.pi / 3), 12))   # tan(60 deg) = sqrt(3)
+    [1.73205081 0.         0.        ]
     """
     return _gibbs_from_unit_quaternion(quaternion_from_axis_angle(axis, angle))
 
 
-def axis_angle_from_gibbs(n) -> tuple[np.ndarray, np.ndarray]:
+def axis_angle_from_gibbs(n: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     r"""Axis and angle :math:`\alpha = 2\arctan|\mathbf n|\in[0,\pi)` of a Gibbs vector (paper eq. 1.8).
 
     Parameters
@@ -1152,11 +1352,19 @@ def axis_angle_from_gibbs(n) -> tuple[np.ndarray, np.ndarray]:
     References
     ----------
     Paper eq. 1.8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import axis_angle_from_gibbs
+    >>> k, alpha = axis_angle_from_gibbs([0.0, 3.0, 4.0])
+    >>> print(k, round(float(alpha), 12), round(float(2 * np.arctan(5.0)), 12))
+    [0.  0.6 0.8] 2.74680153389 2.74680153389
     """
     return axis_angle_from_quaternion(quaternion_from_gibbs(n))
 
 
-def gibbs_from_rotvec(rotvec) -> np.ndarray:
+def gibbs_from_rotvec(rotvec: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector :math:`\mathbf k\tan(\alpha/2)` of a rotation vector :math:`\alpha\mathbf k`.
 
     Parameters
@@ -1177,11 +1385,18 @@ def gibbs_from_rotvec(rotvec) -> np.ndarray:
     References
     ----------
     Paper eq. 1.8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_from_rotvec
+    >>> print(np.round(gibbs_from_rotvec([0.0, 0.0, np.pi / 2]), 12))   # tan(45 deg) = 1
+    [0. 0. 1.]
     """
     return _gibbs_from_unit_quaternion(as_quaternion(quaternion_from_rotvec(rotvec)), "rotvec")
 
 
-def rotvec_from_gibbs(n) -> np.ndarray:
+def rotvec_from_gibbs(n: ArrayLike) -> NDArray[np.float64]:
     r"""Rotation vector :math:`2\arctan(|\mathbf n|)\,\mathbf n/|\mathbf n|` (scipy's :math:`\alpha\mathbf k`).
 
     Parameters
@@ -1200,11 +1415,18 @@ def rotvec_from_gibbs(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.8.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import rotvec_from_gibbs
+    >>> print(np.round(rotvec_from_gibbs([0.0, 0.0, 1.0]) / np.pi, 12))   # pi/2 about z
+    [0.  0.  0.5]
     """
     return rotvec_from_quaternion(quaternion_from_gibbs(n))
 
 
-def gibbs_from_mrp(p) -> np.ndarray:
+def gibbs_from_mrp(p: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector :math:`2\mathbf p/(1-\mathbf p^2)` of modified Rodrigues parameters.
 
     Parameters
@@ -1221,11 +1443,17 @@ def gibbs_from_mrp(p) -> np.ndarray:
         At :math:`|\mathbf p| = 1` (angle :math:`\pi`).
     InvalidInputError
         Wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import gibbs_from_mrp
+    >>> print(gibbs_from_mrp([0.0, 0.5, 0.0]))                    # 2p / (1 - p^2)
+    [0.         1.33333333 0.        ]
     """
     return _gibbs_from_unit_quaternion(as_quaternion(quaternion_from_mrp(p)), "p")
 
 
-def mrp_from_gibbs(n) -> np.ndarray:
+def mrp_from_gibbs(n: ArrayLike) -> NDArray[np.float64]:
     r"""Modified Rodrigues parameters :math:`\mathbf n/(1+\sqrt{1+\mathbf n^2})` of a Gibbs vector.
 
     Parameters
@@ -1240,11 +1468,18 @@ def mrp_from_gibbs(n) -> np.ndarray:
     ------
     InvalidInputError
         Wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import mrp_from_gibbs
+    >>> print(np.round(mrp_from_gibbs([0.0, 4.0 / 3.0, 0.0]), 12))   # n / (1 + sqrt(1 + n^2))
+    [0.  0.5 0. ]
     """
     return mrp_from_quaternion(quaternion_from_gibbs(n))
 
 
-def gibbs_from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
+def gibbs_from_euler(seq: str, angles: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
     r"""Gibbs vector from Euler angles (see :func:`quaternion_from_euler`).
 
     Parameters
@@ -1263,11 +1498,18 @@ def gibbs_from_euler(seq: str, angles, *, degrees: bool = False) -> np.ndarray:
         If the rotation angle is :math:`\pi`.
     InvalidInputError
         Invalid sequence, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_from_euler
+    >>> print(np.round(gibbs_from_euler("xyz", [0.0, 0.0, 90.0], degrees=True), 12))   # 90 degrees about z
+    [0. 0. 1.]
     """
     return _gibbs_from_unit_quaternion(as_quaternion(quaternion_from_euler(seq, angles, degrees=degrees)))
 
 
-def euler_from_gibbs(seq: str, n, *, degrees: bool = False) -> np.ndarray:
+def euler_from_gibbs(seq: str, n: ArrayLike, *, degrees: bool = False) -> NDArray[np.float64]:
     """Euler angles of a Gibbs vector (see :func:`euler_from_quaternion`).
 
     Parameters
@@ -1284,11 +1526,18 @@ def euler_from_gibbs(seq: str, n, *, degrees: bool = False) -> np.ndarray:
     ------
     InvalidInputError
         Invalid sequence, wrong shape or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import euler_from_gibbs
+    >>> print(np.round(euler_from_gibbs("ZYX", [0.0, 0.0, 1.0], degrees=True), 9) + 0.0)
+    [90.  0.  0.]
     """
     return euler_from_quaternion(seq, quaternion_from_gibbs(n), degrees=degrees)
 
 
-def gibbs_compose(n1, n2) -> np.ndarray:
+def gibbs_compose(n1: ArrayLike, n2: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector of the product :math:`R(\mathbf n_1)R(\mathbf n_2)`, in closed form.
 
     .. math:: \mathbf n_{12} = \frac{\mathbf n_1 + \mathbf n_2 + \mathbf n_1\times\mathbf n_2}{1 - \mathbf n_1\cdot\mathbf n_2}
@@ -1316,6 +1565,17 @@ def gibbs_compose(n1, n2) -> np.ndarray:
     References
     ----------
     Paper eq. 1.9 (the product of two such matrices); Shuster (1993), eq. 256.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_compose, matrix_from_gibbs
+    >>> n1, n2 = np.array([0.1, 0.0, 0.0]), np.array([0.0, 0.2, 0.0])
+    >>> n = gibbs_compose(n1, n2)                                  # (n1 + n2 + n1 x n2) / (1 - n1.n2)
+    >>> print(np.round(n, 12))
+    [0.1  0.2  0.02]
+    >>> bool(np.allclose(matrix_from_gibbs(n), matrix_from_gibbs(n1) @ matrix_from_gibbs(n2)))
+    True
     """
     n1 = as_float_array(n1, "n1", (3,))
     n2 = as_float_array(n2, "n2", (3,))
@@ -1342,7 +1602,7 @@ def gibbs_compose(n1, n2) -> np.ndarray:
     return out
 
 
-def gibbs_inverse(n) -> np.ndarray:
+def gibbs_inverse(n: ArrayLike) -> NDArray[np.float64]:
     r"""Gibbs vector of :math:`R(\mathbf n)^{-1} = R(\mathbf n)^T`, which is :math:`-\mathbf n`.
 
     Parameters
@@ -1361,6 +1621,13 @@ def gibbs_inverse(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.9: :math:`R_{ij}(-\mathbf n) = R_{ji}(\mathbf n)`.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import gibbs_compose, gibbs_inverse
+    >>> n = [0.1, -0.2, 0.3]
+    >>> print(gibbs_inverse(n), gibbs_compose(n, gibbs_inverse(n)))
+    [-0.1  0.2 -0.3] [0. 0. 0.]
     """
     return -as_float_array(n, "n", (3,))
 
@@ -1368,7 +1635,7 @@ def gibbs_inverse(n) -> np.ndarray:
 # ---------------------------------------------------------------------------
 # charts
 # ---------------------------------------------------------------------------
-def gibbs_chart(q, reference) -> np.ndarray:
+def gibbs_chart(q: ArrayLike, reference: Attitude | ArrayLike) -> NDArray[np.float64]:
     r"""Local Gibbs vector of ``q`` in the chart centred on ``reference``.
 
     Returns :math:`\mathbf n` with :math:`R(q) = R(q_0)R(\mathbf n)`, i.e. the
@@ -1395,6 +1662,15 @@ def gibbs_chart(q, reference) -> np.ndarray:
         If ``q`` is a rotation by :math:`\pi` relative to ``reference``.
     InvalidInputError
         Zero quaternions, wrong shapes or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_chart
+    >>> ref = [0.0, 1.0, 0.0, 0.0]                                 # 180 degrees about x: no global n
+    >>> q = [0.0, np.cos(0.1), np.sin(0.1), 0.0]                    # near it
+    >>> print(np.round(gibbs_chart(q, ref), 12) + 0.0)             # small in the chart centred there
+    [ 0.          0.         -0.10033467]
     """
     q = as_quaternion(q)
     q0 = as_quaternion(reference, "reference")
@@ -1412,7 +1688,7 @@ def gibbs_chart(q, reference) -> np.ndarray:
     return n
 
 
-def quaternion_from_chart(reference, n) -> np.ndarray:
+def quaternion_from_chart(reference: Attitude | ArrayLike, n: ArrayLike) -> NDArray[np.float64]:
     r"""Attitude :math:`q_0\otimes q(\mathbf n)` of the local Gibbs vector ``n`` in the chart at ``reference``.
 
     The inverse of :func:`gibbs_chart`: :math:`R = R(q_0)R(\mathbf n)`.
@@ -1433,6 +1709,17 @@ def quaternion_from_chart(reference, n) -> np.ndarray:
     ------
     InvalidInputError
         Zero reference, wrong shapes or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_chart, quaternion_from_chart
+    >>> ref = [0.0, 1.0, 0.0, 0.0]
+    >>> q = quaternion_from_chart(ref, [0.0, 0.0, 0.1])
+    >>> print(np.round(q, 9) + 0.0)
+    [ 0.          0.99503719 -0.09950372  0.        ]
+    >>> print(np.round(gibbs_chart(q, ref), 12) + 0.0)             # back to the local n
+    [0.  0.  0.1]
     """
     q0 = as_quaternion(reference, "reference")
     n = as_float_array(n, "n", (3,))
@@ -1443,7 +1730,7 @@ def quaternion_from_chart(reference, n) -> np.ndarray:
 # ---------------------------------------------------------------------------
 # the paper's matrices
 # ---------------------------------------------------------------------------
-def conversion_matrix(n) -> np.ndarray:
+def conversion_matrix(n: ArrayLike) -> NDArray[np.float64]:
     r"""The paper's conversion matrix :math:`A(\mathbf n)` (eq. 1.12).
 
     .. math:: A_{ij} = \frac{\delta_{ij} - \epsilon_{ijk}n_k}{1+\mathbf n^2}
@@ -1469,6 +1756,19 @@ def conversion_matrix(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.11-1.12.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import conversion_matrix
+    >>> print(conversion_matrix([0.0, 0.0, 0.0]))                   # A(0) = 1
+    [[1. 0. 0.]
+     [0. 1. 0.]
+     [0. 0. 1.]]
+    >>> print(np.round(conversion_matrix([0.0, 0.0, 1.0]), 12) + 0.0)
+    [[ 0.5 -0.5  0. ]
+     [ 0.5  0.5  0. ]
+     [ 0.   0.   0.5]]
     """
     n = as_float_array(n, "n", (3,))
     return _A(n)
@@ -1481,7 +1781,7 @@ def _A(n):
         return w * (w * np.eye(3) + _skew(q[..., 1:]))
 
 
-def inverse_conversion_matrix(n) -> np.ndarray:
+def inverse_conversion_matrix(n: ArrayLike) -> NDArray[np.float64]:
     r"""The paper's :math:`\tilde A(\mathbf n) = A^{-1}(\mathbf n)` (eq. 1.12, corrected).
 
     .. math:: \tilde A_{ij} = \delta_{ij} + n_i n_j + \epsilon_{ijk}n_k
@@ -1506,6 +1806,16 @@ def inverse_conversion_matrix(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.12.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import conversion_matrix, inverse_conversion_matrix
+    >>> n = [0.1, 0.2, 0.3]
+    >>> print(np.round(inverse_conversion_matrix(n) @ conversion_matrix(n), 12) + 0.0)   # A~ A = 1
+    [[1. 0. 0.]
+     [0. 1. 0.]
+     [0. 0. 1.]]
     """
     n = as_float_array(n, "n", (3,))
     with np.errstate(over="ignore", invalid="ignore"):
@@ -1517,7 +1827,7 @@ def _At(n):
     return np.eye(3) + _outer(n, n) - _skew(n)
 
 
-def matrix_from_conversion(n) -> np.ndarray:
+def matrix_from_conversion(n: ArrayLike) -> NDArray[np.float64]:
     r"""The rotation matrix as :math:`R = A\tilde A^T` (paper, after eq. 1.12).
 
     Equals :func:`matrix_from_gibbs` (eq. 1.9); kept as an independent
@@ -1539,12 +1849,20 @@ def matrix_from_conversion(n) -> np.ndarray:
     References
     ----------
     Paper eq. 1.12.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import matrix_from_conversion, matrix_from_gibbs
+    >>> n = [0.1, 0.2, 0.3]
+    >>> float(np.max(np.abs(matrix_from_conversion(n) - matrix_from_gibbs(n)))) < 1e-15
+    True
     """
     n = as_float_array(n, "n", (3,))
     return _A(n) @ np.swapaxes(_At(n), -1, -2)
 
 
-def omega_from_gibbs_rate(n, ndot) -> np.ndarray:
+def omega_from_gibbs_rate(n: ArrayLike, ndot: ArrayLike) -> NDArray[np.float64]:
     r"""Body angular velocity :math:`\boldsymbol\Omega = 2A^T\dot{\mathbf n}` (eq. 1.11).
 
     .. math:: \boldsymbol\Omega = \frac{2(\dot{\mathbf n} - \mathbf n\times\dot{\mathbf n})}{1+\mathbf n^2}
@@ -1569,6 +1887,12 @@ def omega_from_gibbs_rate(n, ndot) -> np.ndarray:
     References
     ----------
     Paper eq. 1.10-1.11, 1.24.
+
+    Examples
+    --------
+    >>> from eulerpoisson.attitude import omega_from_gibbs_rate
+    >>> print(omega_from_gibbs_rate([0.0, 0.0, 0.0], [0.0, 0.0, 0.5]))   # at n = 0: Omega = 2 ndot
+    [0. 0. 1.]
     """
     n = as_float_array(n, "n", (3,))
     nd = as_float_array(ndot, "ndot", (3,))
@@ -1576,7 +1900,7 @@ def omega_from_gibbs_rate(n, ndot) -> np.ndarray:
     return 2.0 * np.einsum("...ji,...j->...i", _A(n), nd)
 
 
-def gibbs_rate_from_omega(n, omega) -> np.ndarray:
+def gibbs_rate_from_omega(n: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
     r""":math:`\dot{\mathbf n} = \tfrac12\tilde A^T\boldsymbol\Omega` (eq. 1.30), the inverse of eq. 1.11.
 
     .. math:: \dot{\mathbf n} = \tfrac12\left(\boldsymbol\Omega + \mathbf n\times\boldsymbol\Omega + (\mathbf n\cdot\boldsymbol\Omega)\mathbf n\right)
@@ -1598,6 +1922,14 @@ def gibbs_rate_from_omega(n, omega) -> np.ndarray:
     References
     ----------
     Paper eq. 1.30 (and 1.20).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import gibbs_rate_from_omega, omega_from_gibbs_rate
+    >>> n, w = [0.1, 0.2, 0.3], [1.0, -0.5, 0.25]
+    >>> print(np.round(omega_from_gibbs_rate(n, gibbs_rate_from_omega(n, w)), 12))   # the inverse map
+    [ 1.   -0.5   0.25]
     """
     n = as_float_array(n, "n", (3,))
     w = as_float_array(omega, "omega", (3,))
@@ -1631,7 +1963,7 @@ def _inertia_arrays(inertia, inverse: bool = False):
     )
 
 
-def metric(n, inertia) -> np.ndarray:
+def metric(n: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""The metric :math:`G(\mathbf n) = 4AIA^T` of the geodesic problem (eq. 1.13).
 
     The Lagrangian is :math:`L = \tfrac12 G_{ij}\dot n_i\dot n_j =
@@ -1659,6 +1991,18 @@ def metric(n, inertia) -> np.ndarray:
     References
     ----------
     Paper eq. 1.13.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import metric
+    >>> print(metric([0.0, 0.0, 0.0], [1.0, 2.0, 3.0]))            # G(0) = 4 A I A^T = 4 I
+    [[ 4.  0.  0.]
+     [ 0.  8.  0.]
+     [ 0.  0. 12.]]
+    >>> G = metric([0.1, 0.2, 0.3], [1.0, 2.0, 3.0])
+    >>> bool(np.allclose(G, G.T)), bool(np.all(np.linalg.eigvalsh(G) > 0))
+    (True, True)
     """
     n = as_float_array(n, "n", (3,))
     I = _inertia_arrays(inertia)
@@ -1669,7 +2013,7 @@ def metric(n, inertia) -> np.ndarray:
     return finite_result(out, "metric", n=n)
 
 
-def inverse_metric(n, inertia) -> np.ndarray:
+def inverse_metric(n: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""The inverse metric :math:`G^{-1} = \tfrac14\tilde A^T I^{-1}\tilde A` (eq. 1.14).
 
     Parameters
@@ -1692,6 +2036,16 @@ def inverse_metric(n, inertia) -> np.ndarray:
     References
     ----------
     Paper eq. 1.14.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.attitude import inverse_metric, metric
+    >>> n, inertia = [0.1, 0.2, 0.3], [1.0, 2.0, 3.0]
+    >>> print(np.round(inverse_metric(n, inertia) @ metric(n, inertia), 12) + 0.0)
+    [[1. 0. 0.]
+     [0. 1. 0.]
+     [0. 0. 1.]]
     """
     n = as_float_array(n, "n", (3,))
     Iinv = _inertia_arrays(inertia, inverse=True)
@@ -1750,8 +2104,9 @@ class Attitude:
 
     __slots__ = ("_q",)
     __array_ufunc__ = None  # keep numpy from broadcasting over Attitude objects
+    _q: np.ndarray
 
-    def __init__(self, quaternion):
+    def __init__(self, quaternion: Attitude | ArrayLike) -> None:
         if isinstance(quaternion, Attitude):
             self._q = quaternion._q.copy()
         else:
@@ -1759,7 +2114,7 @@ class Attitude:
 
     # factories ------------------------------------------------------------
     @classmethod
-    def identity(cls, shape=()) -> "Attitude":
+    def identity(cls, shape: int | tuple[int, ...] = ()) -> Attitude:
         """The identity rotation.
 
         Parameters
@@ -1777,7 +2132,7 @@ class Attitude:
         return cls(q)
 
     @classmethod
-    def random(cls, shape=(), rng=None) -> "Attitude":
+    def random(cls, shape: int | tuple[int, ...] = (), rng: int | np.random.Generator | None = None) -> Attitude:
         """Uniformly (Haar) distributed random rotations: normalized Gaussian quaternions.
 
         Parameters
@@ -1796,7 +2151,7 @@ class Attitude:
         return cls(rng.standard_normal(shape + (4,)))
 
     @classmethod
-    def from_quaternion(cls, q) -> "Attitude":
+    def from_quaternion(cls, q: ArrayLike) -> Attitude:
         """From scalar-first quaternions.
 
         Parameters
@@ -1816,7 +2171,7 @@ class Attitude:
         return cls(q)
 
     @classmethod
-    def from_gibbs(cls, n) -> "Attitude":
+    def from_gibbs(cls, n: ArrayLike) -> Attitude:
         """From the paper's Gibbs vectors (eq. 1.8-1.9).
 
         Parameters
@@ -1835,7 +2190,7 @@ class Attitude:
         return cls(quaternion_from_gibbs(n))
 
     @classmethod
-    def from_matrix(cls, R, *, atol: float = 1e-6) -> "Attitude":
+    def from_matrix(cls, R: ArrayLike, *, atol: float = 1e-6) -> Attitude:
         """From rotation matrices (see :func:`quaternion_from_matrix`).
 
         Parameters
@@ -1856,7 +2211,7 @@ class Attitude:
         return cls(quaternion_from_matrix(R, atol=atol))
 
     @classmethod
-    def from_axis_angle(cls, axis, angle) -> "Attitude":
+    def from_axis_angle(cls, axis: ArrayLike, angle: ArrayLike) -> Attitude:
         """From rotation axes and angles.
 
         Parameters
@@ -1878,7 +2233,7 @@ class Attitude:
         return cls(quaternion_from_axis_angle(axis, angle))
 
     @classmethod
-    def from_rotvec(cls, rotvec) -> "Attitude":
+    def from_rotvec(cls, rotvec: ArrayLike) -> Attitude:
         """From rotation vectors :math:`\\alpha\\mathbf k` (scipy's rotvec).
 
         Parameters
@@ -1897,7 +2252,7 @@ class Attitude:
         return cls(quaternion_from_rotvec(rotvec))
 
     @classmethod
-    def from_mrp(cls, p) -> "Attitude":
+    def from_mrp(cls, p: ArrayLike) -> Attitude:
         """From modified Rodrigues parameters :math:`\\mathbf k\\tan(\\alpha/4)`.
 
         Parameters
@@ -1916,7 +2271,7 @@ class Attitude:
         return cls(quaternion_from_mrp(p))
 
     @classmethod
-    def from_euler(cls, seq: str, angles, *, degrees: bool = False) -> "Attitude":
+    def from_euler(cls, seq: str, angles: ArrayLike, *, degrees: bool = False) -> Attitude:
         """From Euler angles (see :func:`quaternion_from_euler`).
 
         Parameters
@@ -1938,7 +2293,7 @@ class Attitude:
         return cls(quaternion_from_euler(seq, angles, degrees=degrees))
 
     @classmethod
-    def from_scipy(cls, rotation) -> "Attitude":
+    def from_scipy(cls, rotation: Rotation) -> Attitude:
         """From a :class:`scipy.spatial.transform.Rotation`, keeping its batch shape.
 
         Parameters
@@ -1957,7 +2312,7 @@ class Attitude:
         return cls(quaternion_from_scipy(rotation))
 
     @classmethod
-    def from_chart(cls, reference, n) -> "Attitude":
+    def from_chart(cls, reference: Attitude | ArrayLike, n: ArrayLike) -> Attitude:
         """From local Gibbs vectors in the chart at ``reference``: :math:`R = R_0R(\\mathbf n)`.
 
         Parameters
@@ -1979,7 +2334,7 @@ class Attitude:
         return cls(quaternion_from_chart(_ref_quaternion(reference), n))
 
     # views ----------------------------------------------------------------
-    def as_quaternion(self, canonical: bool = False) -> np.ndarray:
+    def as_quaternion(self, canonical: bool = False) -> NDArray[np.float64]:
         """Unit scalar-first quaternions (a copy).
 
         Parameters
@@ -1993,7 +2348,7 @@ class Attitude:
         """
         return _canonical(self._q) if as_bool(canonical, "canonical") else self._q.copy()
 
-    def as_gibbs(self) -> np.ndarray:
+    def as_gibbs(self) -> NDArray[np.float64]:
         """The paper's Gibbs vectors :math:`\\mathbf n = \\mathbf k\\tan(\\alpha/2)` (eq. 1.8).
 
         Returns
@@ -2007,7 +2362,7 @@ class Attitude:
         """
         return _gibbs_from_unit_quaternion(self._q)
 
-    def as_chart(self, reference) -> np.ndarray:
+    def as_chart(self, reference: Attitude | ArrayLike) -> NDArray[np.float64]:
         """Local Gibbs vectors relative to ``reference`` (see :func:`gibbs_chart`).
 
         Parameters
@@ -2025,7 +2380,7 @@ class Attitude:
         """
         return gibbs_chart(self._q, _ref_quaternion(reference))
 
-    def as_matrix(self) -> np.ndarray:
+    def as_matrix(self) -> NDArray[np.float64]:
         """Rotation matrices (paper eq. 1.9).
 
         Returns
@@ -2034,7 +2389,7 @@ class Attitude:
         """
         return matrix_from_unit_quaternion(self._q)
 
-    def as_axis_angle(self) -> tuple[np.ndarray, np.ndarray]:
+    def as_axis_angle(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Unit axes and angles in :math:`[0, \\pi]`.
 
         Returns
@@ -2044,7 +2399,7 @@ class Attitude:
         """
         return axis_angle_from_quaternion(self._q)
 
-    def as_rotvec(self) -> np.ndarray:
+    def as_rotvec(self) -> NDArray[np.float64]:
         """Rotation vectors :math:`\\alpha\\mathbf k` with :math:`\\alpha\\in[0,\\pi]`.
 
         Returns
@@ -2053,7 +2408,7 @@ class Attitude:
         """
         return rotvec_from_quaternion(self._q)
 
-    def as_mrp(self) -> np.ndarray:
+    def as_mrp(self) -> NDArray[np.float64]:
         """Modified Rodrigues parameters with norm <= 1.
 
         Returns
@@ -2062,7 +2417,7 @@ class Attitude:
         """
         return mrp_from_quaternion(self._q)
 
-    def as_euler(self, seq: str, *, degrees: bool = False) -> np.ndarray:
+    def as_euler(self, seq: str, *, degrees: bool = False) -> NDArray[np.float64]:
         """Euler angles (see :func:`euler_from_quaternion` for ranges and gimbal lock).
 
         Parameters
@@ -2081,7 +2436,7 @@ class Attitude:
         """
         return euler_from_quaternion(seq, self._q, degrees=degrees)
 
-    def as_scipy(self):
+    def as_scipy(self) -> Rotation:
         """A :class:`scipy.spatial.transform.Rotation` with the same batch shape.
 
         Multi-axis batches are kept as N-D rotations (scipy >= 1.17); they are
@@ -2100,7 +2455,7 @@ class Attitude:
         return scipy_from_quaternion(self._q)
 
     # algebra --------------------------------------------------------------
-    def __mul__(self, other: "Attitude") -> "Attitude":
+    def __mul__(self, other: Attitude) -> Attitude:
         """``a * b``: the rotation :math:`R_aR_b` (apply ``b`` first); batch shapes broadcast."""
         if not isinstance(other, Attitude):
             return NotImplemented
@@ -2109,7 +2464,7 @@ class Attitude:
 
     __matmul__ = __mul__
 
-    def inv(self) -> "Attitude":
+    def inv(self) -> Attitude:
         """The inverse rotations, :math:`R^T`.
 
         Returns
@@ -2118,7 +2473,7 @@ class Attitude:
         """
         return Attitude(self._q * _CONJ)
 
-    def apply(self, vectors, inverse: bool = False) -> np.ndarray:
+    def apply(self, vectors: ArrayLike, inverse: bool = False) -> NDArray[np.float64]:
         """Rotate vectors: ``R v`` (body to space) or ``R^T v`` with ``inverse=True``.
 
         Parameters
@@ -2142,7 +2497,7 @@ class Attitude:
             R = np.swapaxes(R, -1, -2)
         return np.einsum("...ij,...j->...i", R, v)
 
-    def magnitude(self) -> np.ndarray:
+    def magnitude(self) -> NDArray[np.float64]:
         """Rotation angles in :math:`[0, \\pi]`.
 
         Returns
@@ -2151,7 +2506,7 @@ class Attitude:
         """
         return self.as_axis_angle()[1]
 
-    def angle_to(self, other: "Attitude") -> np.ndarray:
+    def angle_to(self, other: Attitude) -> NDArray[np.float64]:
         """Angle of the rotation taking ``self`` to ``other``: the angle of :math:`R_\\mathrm{self}^TR_\\mathrm{other}`.
 
         The geodesic (bi-invariant) distance on SO(3), computed with
@@ -2193,7 +2548,7 @@ class Attitude:
         """Number of attitudes in the batch."""
         return int(np.prod(self.shape, dtype=int))
 
-    def reshape(self, *shape) -> "Attitude":
+    def reshape(self, *shape: int | tuple[int, ...]) -> Attitude:
         """The same attitudes with a new batch shape.
 
         Parameters
@@ -2219,14 +2574,14 @@ class Attitude:
             raise TypeError("a single Attitude has no len()")
         return self.shape[0]
 
-    def __getitem__(self, idx) -> "Attitude":
+    def __getitem__(self, idx: Any) -> Attitude:
         """Attitudes of the batch; indexes the batch axes only, never the quaternion axis."""
         if not self.shape:
             raise TypeError("a single Attitude cannot be indexed")
         pos = np.arange(self.size).reshape(self.shape)[idx]
         return Attitude(self._q.reshape(-1, 4)[pos])
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Attitude]:
         if not self.shape:
             raise TypeError("a single Attitude is not iterable")
         for i in range(self.shape[0]):

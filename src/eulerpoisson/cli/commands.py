@@ -1,6 +1,7 @@
 """The ``eulerpoisson`` command line.
 
-Commands: ``simulate``, ``audit``, ``plot``, ``animate``, ``info``, ``sweep``, ``demo``.
+Commands: ``simulate``, ``audit``, ``plot``, ``animate``, ``info``, ``sweep``, ``demo``, ``validate``,
+``cases``, ``fit``, ``warmup``.
 Bad input prints one line that says what is wrong and exits with status 2
 (``--debug``, anywhere on the command line, shows the traceback instead).
 Python warnings (overflow, ill-conditioning, ...) are silenced unless
@@ -74,12 +75,12 @@ def _floats(text, name: str, sizes: tuple[int, ...]) -> list[float]:
     return arr.tolist()
 
 
-def _inertia_from(value, name="--inertia"):
+def inertia_from(value, name="--inertia"):
     v = _floats(value, name, (3, 9))
     return np.array(v) if len(v) == 3 else np.array(v).reshape(3, 3)
 
 
-def _check_file_name(value, name: str) -> None:
+def check_file_name(value, name: str) -> None:
     """Reject an empty (or blank) file name given to option ``name``."""
     if value is not None and not str(value).strip():
         raise UsageError(f"{name}: empty file name")
@@ -88,7 +89,7 @@ def _check_file_name(value, name: str) -> None:
 def _load_toml(path: str) -> dict:
     import tomllib
 
-    _check_file_name(path, "configuration file")
+    check_file_name(path, "configuration file")
     p = Path(path)
     if not p.exists():
         raise UsageError(f"configuration file {path!r} does not exist")
@@ -312,7 +313,7 @@ def _build_body(cfg, name=None):
         return RigidBody.from_particles(masses, positions, name=label)
     if "body.inertia" not in cfg:
         raise UsageError("no body given: use --inertia I1,I2,I3 (or nine numbers) or a TOML file with [body]")
-    return RigidBody(_inertia_from(cfg["body.inertia"], name("body.inertia")), name=label,
+    return RigidBody(inertia_from(cfg["body.inertia"], name("body.inertia")), name=label,
                      allow_unphysical=bool(cfg.get("body.allow_unphysical", False)))
 
 
@@ -333,10 +334,10 @@ def _build_torques(cfg, name=None) -> list:
     A heavy top needs the centre of mass (``--com``); the mass defaults to 1 and
     the gravitational acceleration to (0, 0, -9.81).
     """
-    from ..model.torques import STANDARD_GRAVITY, BodyTorque, Gravity, GravityGradient, SpaceTorque
+    from ..model.torques import STANDARD_GRAVITY, BodyTorque, Gravity, GravityGradient, SpaceTorque, Torque
 
     name = name or _namer({})
-    torques = []
+    torques: list[Torque] = []
     if "torque.center_of_mass" in cfg:
         com = _floats(cfg["torque.center_of_mass"], name("torque.center_of_mass"), (3,))
         mass = _number(cfg["torque.mass"], name("torque.mass"), positive=True) if "torque.mass" in cfg else 1.0
@@ -468,10 +469,9 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: boo
     so memory does not grow with the samples; returns ``(trajectory of those
     two samples, drift)``.
     """
-    from ..model.drift import DriftAccumulator
-
-    from ..solvers import get_method, solve
     from ..io.stream import ProgressDisplay, solve_from
+    from ..model.drift import DriftAccumulator
+    from ..solvers import get_method, solve
     from ..trajectory import Trajectory
 
     closed_form = get_method(method).order is None
@@ -485,10 +485,15 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: boo
         return tr if keep else (tr, tr.drift())
     acc = None if keep else DriftAccumulator(model)
     pieces = [p for p in np.array_split(np.arange(t.size), min(CHUNKS, t.size)) if p.size]
-    qs, ws, wall = [], [], 0.0
+    qs: list[np.ndarray] = []
+    ws: list[np.ndarray] = []
+    wall = 0.0
     first = None
     qs_end_index = 0  # the last output time of the previous chunk (a stepping method continues from it)
-    with ProgressDisplay(progress, t.size, f"{method}: solving") as bar:
+    from ..util.jit import whole_run
+
+    # one choice of compiled kernels or NumPy for the whole run, not per chunk (the same numbers as one call)
+    with ProgressDisplay(progress, t.size, f"{method}: solving") as bar, whole_run(n_times=t.size):
         done = 0
         for idx in pieces:
             if closed_form or first is None:
@@ -509,6 +514,7 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: boo
             wall += tr.stats.get("wall_time", 0.0)
             done += idx.size
             bar.update(done)
+    assert first is not None  # there is at least one piece
     stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
     if acc is not None:
         ends = Trajectory(t[[0, -1]], np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
@@ -640,7 +646,7 @@ def cmd_simulate(args) -> int:
                              f"got {cfg['compute.workers']!r}")
         opts["workers"] = workers  # a keyword of solve, solve_from and solve_to_file, not a method option
     out = cfg.get("output.file")
-    _check_file_name(out, name("output.file"))
+    check_file_name(out, name("output.file"))
     as_json = bool(args.json or cfg.get("output.json", False))
     progress = False if (args.quiet or as_json) else None
     if out is not None and not str(out).endswith((".nc", ".nc4", ".netcdf", ".zarr")):
@@ -708,7 +714,7 @@ def cmd_simulate(args) -> int:
 def cmd_audit(args) -> int:
     from ..paper.audit import run_audit, write_report
 
-    _check_file_name(args.out, "--out")
+    check_file_name(args.out, "--out")
     if args.out is not None:
         from ..io.outputs import check_output
 
@@ -732,7 +738,7 @@ def _read_traj(path):
     from ..io.read import file_format
     from ..trajectory import Trajectory
 
-    _check_file_name(path, "trajectory file")
+    check_file_name(path, "trajectory file")
     if not os.path.exists(path):
         raise UsageError(f"{path}: no such file (write one with 'eulerpoisson simulate ... --out {path}')")
     if os.path.isdir(path) and file_format(path) != "zarr":
@@ -751,12 +757,11 @@ def _read_traj(path):
 
 
 def cmd_plot(args) -> int:
-    _check_file_name(args.out, "--out")
+    check_file_name(args.out, "--out")
     out = args.out if args.out is not None else f"{Path(args.file).stem}_{args.kind}.png"
     if args.kind == "atlas":
-        from ..sweep.runner import load_sweep, plot_atlas
-
         from ..io.outputs import file_kind
+        from ..sweep.runner import load_sweep, plot_atlas
 
         if not os.path.exists(args.file):
             raise UsageError(f"{args.file}: no such sweep store (make one with 'eulerpoisson sweep sweep.toml')")
@@ -786,9 +791,9 @@ def _fps(text) -> float:
 
 
 def cmd_animate(args) -> int:
-    from ..viz.animate import FORMATS, default_duration, animate
+    from ..viz.animate import FORMATS, animate, default_duration
 
-    _check_file_name(args.out, "--out")
+    check_file_name(args.out, "--out")
     ext = Path(args.out).suffix.lower().lstrip(".")
     if ext not in FORMATS and ext != "htm":
         raise UsageError(f"--out {args.out!r}: unsupported file extension; use .html (self-contained page), .gif or .mp4")
@@ -882,7 +887,7 @@ def _resume_command(target: str, fp: dict) -> str | None:
     """
     import inspect
 
-    from ..io.stream import TIME_VARIABLES, _torque_fingerprint, solve_to_file
+    from ..io.stream import TIME_VARIABLES, solve_to_file, torque_fingerprint
     from ..model.body import RigidBody
     from ..model.equations import Model
     from ..solvers import get_method, make_problem
@@ -905,7 +910,7 @@ def _resume_command(target: str, fp: dict) -> str | None:
         cfg["body.inertia"] = ",".join(_num(v) for v in (np.diag(inertia) if diag else inertia.ravel()))
         flags += ["--inertia", cfg["body.inertia"]]
         try:
-            RigidBody(_inertia_from(cfg["body.inertia"]))
+            RigidBody(inertia_from(cfg["body.inertia"]))
         except EulerPoissonError:
             cfg["body.allow_unphysical"] = True
             flags.append("--allow-unphysical")
@@ -952,7 +957,7 @@ def _resume_command(target: str, fp: dict) -> str | None:
                 "times": {"grid": [0.0, float(_num(t_end)), int(samples)]}, "chunk": chunk, "n": int(samples),
                 "variables": list(TIME_VARIABLES)}
         if not model.is_free:
-            mine["torque"] = _torque_fingerprint(model)
+            mine["torque"] = torque_fingerprint(model)
         if json.loads(json.dumps(mine, default=float, sort_keys=True)) != fp:
             return None
     except Exception:  # noqa: BLE001 - anything unexpected: no command rather than a wrong one
@@ -964,7 +969,7 @@ def _resume_command(target: str, fp: dict) -> str | None:
 
 def _info_partial(args, target: Path, work: Path) -> int:
     """``info`` of an unfinished stream: how far it got, up to what time, and how to resume it."""
-    from ..io.outputs import _pid_alive
+    from ..io.outputs import pid_alive
     from ..io.stream import TimeGrid
 
     try:
@@ -978,9 +983,9 @@ def _info_partial(args, target: Path, work: Path) -> int:
         n, chunk = int(fp["n"]), int(fp["chunk"])
         fp["times"]["grid" if "grid" in fp["times"] else "array"]
     except (TypeError, KeyError):  # not a trajectory stream: a sweep (or a newer format)
-        done = [f for f in (work / "done").iterdir() if f.name.isdigit()] if (work / "done").is_dir() else []
+        finished = [f for f in (work / "done").iterdir() if f.name.isdigit()] if (work / "done").is_dir() else []
         print(f"{args.file}: an unfinished sweep (or another unfinished result) to {target}, not a trajectory: "
-              f"{len(done)} chunk(s) finished; run the command that wrote it again to resume it "
+              f"{len(finished)} chunk(s) finished; run the command that wrote it again to resume it "
               f"('eulerpoisson sweep CONFIG --out {target}')")
         return 0
     nchunks = max(1, -(-n // chunk))
@@ -997,7 +1002,7 @@ def _info_partial(args, target: Path, work: Path) -> int:
         pid = int(lock.read_text().strip() or "0")
     except (OSError, ValueError):
         pass
-    running = bool(pid) and pid != os.getpid() and _pid_alive(pid)
+    running = bool(pid) and pid != os.getpid() and pid_alive(pid)
     state = f"being written now (process {pid})" if running else "interrupted"
     lines = [f"{args.file}: unfinished run to {target} ({state}): {len(done)} of {nchunks} chunks finished, "
              f"{samples_done} of {n} samples ({100.0 * samples_done / n:.3g}%)" if n else
@@ -1008,9 +1013,9 @@ def _info_partial(args, target: Path, work: Path) -> int:
         if grid is not None:
             g = TimeGrid(float(grid[0]), float(grid[1]), int(grid[2]))
             return [float(g[i:i + 1][0]) for i in idx]
-        from ..io.read import _zarr_group
+        from ..io.read import zarr_group
 
-        tarr = _zarr_group(work / "store.zarr")["time"]
+        tarr = zarr_group(work / "store.zarr")["time"]
         return [float(tarr[i]) for i in idx]
 
     try:
@@ -1056,7 +1061,7 @@ def _info_partial(args, target: Path, work: Path) -> int:
 
 
 def cmd_info(args) -> int:
-    _check_file_name(args.file, "trajectory file")
+    check_file_name(args.file, "trajectory file")
     partial = _partial_run_of(args.file)
     if partial is not None and (partial[2] or not os.path.exists(args.file)):
         return _info_partial(args, partial[0], partial[1])
@@ -1093,8 +1098,8 @@ def cmd_info(args) -> int:
 def cmd_sweep(args) -> int:
     from ..sweep.runner import load_config, run_sweep
 
-    _check_file_name(args.config, "sweep file")
-    _check_file_name(args.out, "--out")
+    check_file_name(args.config, "sweep file")
+    check_file_name(args.out, "--out")
     if not os.path.exists(args.config):
         raise UsageError(f"sweep file {args.config!r} does not exist (see examples/sweep.toml)")
     if not os.path.isfile(args.config):
@@ -1133,7 +1138,7 @@ def cmd_sweep(args) -> int:
 def cmd_demo(args) -> int:
     from .demo import run_demo
 
-    _check_file_name(args.out, "--out")
+    check_file_name(args.out, "--out")
     return run_demo(args.out, quiet=args.quiet)
 
 
@@ -1303,6 +1308,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .fit import add_commands as add_fit_command  # fit (issue 13)
 
     add_fit_command(sub)
+    from .warmup import add_commands as add_warmup_command  # warmup (issue 15, cold start)
+
+    add_warmup_command(sub)
     return p
 
 
@@ -1313,7 +1321,8 @@ def build_parser() -> argparse.ArgumentParser:
 # ---------------------------------------------------------------------------
 def _value_options(parser: argparse.ArgumentParser) -> tuple[set[str], set[str]]:
     """Long options that take a value, and all option strings, of ``parser`` and its subcommands."""
-    takes, every = set(), set()
+    takes: set[str] = set()
+    every: set[str] = set()
     stack = [parser]
     while stack:
         p = stack.pop()
@@ -1413,6 +1422,14 @@ def main(argv=None) -> int:
     ``eulerpoisson: error: ...`` (or the usage message) to stderr and returns
     2; ``--debug`` anywhere on the command line shows the traceback (and
     Python warnings) instead.
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli import main
+    >>> main(["simulate", "--inertia", "1,2,2.5", "--omega", "1,0.1,0.5", "--t-end", "1", "--json"])
+    {"t": 1.0, "quaternion": [0.849693475..., 0.454793915..., 0.133837061..., 0.230805400...],
+     ..., "method": "exact", ...}
+    0
     """
     argv = [str(a) for a in (sys.argv[1:] if argv is None else argv)]
     debug = "--debug" in argv[: argv.index("--")] if "--" in argv else "--debug" in argv

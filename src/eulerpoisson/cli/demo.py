@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -37,15 +38,15 @@ from ..solvers import solve
 __all__ = ["run_demo", "run_top", "run_fit", "TENNIS_RACKET", "HEAVY_TOP", "TUMBLER"]
 
 #: the demo's body and initial body angular momentum
-TENNIS_RACKET = {"inertia": (3.0, 5.0, 8.0), "M0": (0.0, 2.0, 0.01)}
+TENNIS_RACKET: dict[str, Any] = {"inertia": (3.0, 5.0, 8.0), "M0": (0.0, 2.0, 0.01)}
 
 #: the heavy-top scene: inertia about the fixed point, torque, initial tilt (about x), spin, time span
-HEAVY_TOP = {"inertia": (1.0, 1.0, 0.5), "mass": 1.0, "center_of_mass": (0.0, 0.0, 0.25), "g": (0.0, 0.0, -9.81),
+HEAVY_TOP: dict[str, Any] = {"inertia": (1.0, 1.0, 0.5), "mass": 1.0, "center_of_mass": (0.0, 0.0, 0.25), "g": (0.0, 0.0, -9.81),
              "tilt_deg": 60.0, "omega0": (0.0, 0.0, 10.0), "t_end": 15.0, "samples": 3001}
 
 
 #: the fit scene: the tumbling body, its state at t = 0, the observations and their noise
-TUMBLER = {"moments": (0.22, 0.35, 0.43), "omega0": (0.3, -0.2, 1.0), "attitude0": (0.7, 0.1, -0.5, 0.5),
+TUMBLER: dict[str, Any] = {"moments": (0.22, 0.35, 0.43), "omega0": (0.3, -0.2, 1.0), "attitude0": (0.7, 0.1, -0.5, 0.5),
            "t_end": 40.0, "samples": 120, "sigma_attitude_deg": 0.1, "sigma_omega": 2e-3, "seed": 1}
 
 

@@ -13,7 +13,7 @@ import math
 import os
 import sys
 
-from .commands import UsageError, _check_file_name, _inertia_from
+from .commands import UsageError, check_file_name, inertia_from
 
 __all__ = ["add_commands", "cmd_validate", "cmd_cases"]
 
@@ -56,9 +56,9 @@ def cmd_validate(args) -> int:
     from ..errors import InvalidInputError
     from ..oracle import validate
 
-    _check_file_name(args.run, "run file")
-    _check_file_name(args.plot, "--plot")
-    inertia = _inertia_from(args.inertia) if args.inertia is not None else None
+    check_file_name(args.run, "run file")
+    check_file_name(args.plot, "--plot")
+    inertia = inertia_from(args.inertia) if args.inertia is not None else None
     tol = _tolerance(args.tolerance)
     if not os.path.exists(args.run):
         raise UsageError(f"{args.run}: no such file (a run: .csv with header t,qw,qx,qy,qz,wx,wy,wz, .nc or .json)")
@@ -93,10 +93,10 @@ def cmd_validate(args) -> int:
             f"  energy drift       {rep.energy_drift:.3e} (relative, of the run)",
             f"  momentum drift     {rep.momentum_drift:.3e} (relative, of the run)",
         ]
-        if rep.flip_times is not None:
+        if rep.flip_times is not None and rep.flip_time_errors is not None:  # (set together)
             lines.append(f"  flips (exact)      {_fmt_times(rep.flip_times)}")
             errs = [e for e in rep.flip_time_errors if math.isfinite(e)]
-            lines.append(f"  flip time errors   " + (", ".join(f"{e:+.3e}" for e in rep.flip_time_errors[:6])
+            lines.append("  flip time errors   " + (", ".join(f"{e:+.3e}" for e in rep.flip_time_errors[:6])
                                                        if errs else "the run does not flip"))
         if rep.tolerance is not None:
             lines.append(f"  tolerance          {rep.tolerance:g} rad: " +
@@ -111,7 +111,7 @@ def cmd_validate(args) -> int:
 def cmd_cases(args) -> int:
     from ..oracle import CASE_NAMES, write_cases
 
-    _check_file_name(args.out, "--out")
+    check_file_name(args.out, "--out")
     names = None
     if args.only is not None:
         names = [n.strip() for n in args.only.split(",") if n.strip()]

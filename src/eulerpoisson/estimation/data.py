@@ -36,7 +36,20 @@ UNIT_TOL = 1e-6
 
 
 class FitInputError(InvalidInputError):
-    """Observations or options that a fit cannot use (a ValueError)."""
+    """Observations or options that a fit cannot use (a ValueError).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.estimation import FitInputError
+    >>> try:
+    ...     ep.fit([0.0, 1.0, 2.0])                                    # no observations at all
+    ... except FitInputError as err:
+    ...     print(err)
+    no observations: give attitude, omega or axis_direction (rows of NaN are missing ones)
+    >>> issubclass(FitInputError, ValueError)
+    True
+    """
 
 
 @dataclass(frozen=True)
@@ -97,7 +110,7 @@ class ObservationSet:
         """Whether the data constrain the attitude at all (else it is not fitted)."""
         return bool(len(self.att_idx) or len(self.ax_idx) or (len(self.om_idx) and self.omega_frame == "space"))
 
-    def with_sigmas(self, scale: dict) -> "ObservationSet":
+    def with_sigmas(self, scale: dict) -> ObservationSet:
         """A copy with each kind's sigmas multiplied by ``scale[kind]``."""
         from dataclasses import replace
 
@@ -108,7 +121,7 @@ class ObservationSet:
             ax_sigma=self.ax_sigma * scale.get("axis", 1.0),
         )
 
-    def window(self, t_end: float) -> "ObservationSet":
+    def window(self, t_end: float) -> ObservationSet:
         """The observations at times up to ``t_end`` (the times array itself is kept)."""
         from dataclasses import replace
 

@@ -36,7 +36,11 @@ Uncertainties
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
 from ..numerics.quaternion import CONJUGATE, qmul
@@ -44,7 +48,12 @@ from .data import FitInputError, observation_set, quaternion_array
 from .lm import LMOutcome, levenberg_marquardt
 from .residuals import FitState, Layout, evaluate, inertia_matrix, inertia_valid, log_quaternion
 from .result import FitResult, LocalOptimum
-from .starts import params_of, starts as make_starts
+from .starts import params_of
+from .starts import starts as make_starts
+
+if TYPE_CHECKING:
+    from ..attitude.core import AttitudeLike
+    from ..model.body import RigidBody
 
 __all__ = ["fit"]
 
@@ -106,7 +115,7 @@ def _close(a, b, tol=1e-3) -> bool:
 def _race(layout, obs, starts, ends, max_iter):
     """Carry all starts through the windows together, dropping the clearly worse and merging the equal."""
     live = [(s, (s.inertia_params.copy(), PRIOR_SIGMA)) for s in starts]
-    results = []
+    results: list[tuple[LMOutcome, tuple]] = []
     for j, t_end in enumerate(ends):
         final = j == len(ends) - 1
         sub = obs if final else obs.window(t_end)
@@ -122,7 +131,7 @@ def _race(layout, obs, starts, ends, max_iter):
             break
         best = min(o.evaluation.chi2 for o, _ in results)
         keep = RACE_FACTOR * max(best, 1e-300)
-        merged = []
+        merged: list[tuple[LMOutcome, tuple]] = []
         for o, p in sorted(results, key=lambda r: r[0].evaluation.chi2):
             if o.evaluation.chi2 <= keep and not any(_close(o.state, m[0].state) for m in merged):
                 merged.append((o, p))
@@ -170,8 +179,8 @@ def _sigma_scales(layout, obs, ev):
     return scales
 
 
-def fit(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, omega_frame="body", axis=None,
-        axis_direction=None, axis_sigma=None, inertia=None, principal_axes="given", initial=None,
+def fit(t: ArrayLike, *, attitude: AttitudeLike | None = None, attitude_sigma: ArrayLike | None = None, omega: ArrayLike | None = None, omega_sigma: ArrayLike | None = None, omega_frame: str = "body", axis: ArrayLike | None = None,
+        axis_direction: ArrayLike | None = None, axis_sigma: ArrayLike | None = None, inertia: RigidBody | ArrayLike | None = None, principal_axes: str = "given", initial: Mapping[str, ArrayLike] | None = None,
         max_iter: int = 200) -> FitResult:
     r"""Fit a torque-free rigid body to observations of its rotation: inertia ratios and the initial state.
 

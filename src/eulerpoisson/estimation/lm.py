@@ -60,6 +60,7 @@ def _evaluate(layout, obs, state, prior):
     p0, sig = prior
     q = len(p0)
     r = (state.inertia_params - p0) / sig
+    assert ev.jacobian is not None  # evaluate() computes it unless told not to
     Jp = np.zeros((q, ev.jacobian.shape[1]))
     Jp[:, -q:] = np.eye(q) / sig
     res = np.concatenate([ev.residuals, r])

@@ -94,6 +94,7 @@ def inertia_matrix(layout: Layout, p) -> tuple[np.ndarray, np.ndarray]:
     """The trace-1 inertia tensor and its derivatives (Q, 3, 3) with respect to the inertia parameters."""
     p = np.asarray(p, dtype=float)
     if layout.inertia_mode == "fixed":
+        assert layout.fixed_inertia is not None  # a fixed layout carries its tensor
         return layout.fixed_inertia, np.zeros((0, 3, 3))
     if layout.inertia_mode == "given":
         return np.diag([p[0], p[1], 1.0 - p[0] - p[1]]), _DIAG

@@ -3,21 +3,47 @@ r"""What a fit returns: the body, the state at the epoch, their uncertainties, t
 from __future__ import annotations
 
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..attitude.core import Attitude
 from ..numerics.quaternion import CONJUGATE, qmul
 from .residuals import inertia_matrix, log_quaternion
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
+    from ..attitude.core import AttitudeLike
+    from ..model.body import RigidBody
+    from ..trajectory import Trajectory
+    from .data import ObservationSet
 
 __all__ = ["FitResult", "LocalOptimum"]
 
 
 @dataclass(frozen=True)
 class LocalOptimum:
-    """A distinct optimum the search reached: its :math:`\\chi^2`, inertia (trace 1), attitude and rate at the epoch."""
+    """A distinct optimum the search reached: its :math:`\\chi^2`, inertia (trace 1), attitude and rate at the epoch.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> t = np.linspace(0.0, 10.0, 41)
+    >>> truth = ep.solve([0.25, 0.33, 0.42], t, omega0=[0.1, 0.2, 1.0])
+    >>> res = ep.fit(t, omega=truth.omega, omega_sigma=1e-3, inertia=[0.25, 0.33, 0.42])
+    >>> best = res.local_optima[0]                                    # best first
+    >>> type(best).__name__, bool(best.chi2 < 1e-12), best.converged
+    ('LocalOptimum', True, True)
+    >>> sorted(best.as_dict())
+    ['attitude0', 'chi2', 'converged', 'inertia', 'omega0']
+    """
 
     chi2: float
     inertia: np.ndarray
@@ -31,7 +57,7 @@ class LocalOptimum:
             a.flags.writeable = False
             object.__setattr__(self, name, a)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         return {"chi2": float(self.chi2), "inertia": self.inertia.tolist(), "attitude0": self.q0.tolist(),
                 "omega0": self.omega0.tolist(), "converged": bool(self.converged)}
 
@@ -112,9 +138,50 @@ class FitResult:
         names the kinds whose sigma was estimated from the residuals.
     local_optima : tuple of LocalOptimum
         Distinct optima found by the search, best first.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> t = np.linspace(0.0, 10.0, 41)
+    >>> truth = ep.solve([0.25, 0.33, 0.42], t, omega0=[0.1, 0.2, 1.0])
+    >>> res = ep.fit(t, omega=truth.omega, omega_sigma=1e-3, inertia=[0.25, 0.33, 0.42])
+    >>> res.parameter_names
+    ('omega0_x', 'omega0_y', 'omega0_z')
+    >>> print(np.round(res.omega0, 6), res.converged)
+    [0.1 0.2 1. ] True
+    >>> print(np.round(res.principal_moments, 6))                    # trace 1
+    [0.25 0.33 0.42]
     """
 
-    def __init__(self, **kw):
+    # what _from_search sets (read-only: arrays not writeable, dicts as mappings, lists as tuples)
+    epoch: float
+    inertia: NDArray[np.float64]
+    principal_moments: NDArray[np.float64]
+    principal_axes: NDArray[np.float64]
+    attitude0: Attitude
+    omega0: NDArray[np.float64]
+    parameter_names: tuple[str, ...]
+    parameters: Mapping[str, float]
+    covariance: NDArray[np.float64]
+    stderr: Mapping[str, float]
+    determined: bool
+    chi2: float
+    dof: int
+    reduced_chi2: float
+    residuals: Mapping[str, NDArray[np.float64]]
+    sigma: Mapping[str, float]
+    sigma_estimated: tuple[str, ...]
+    local_optima: tuple[LocalOptimum, ...]
+    converged: bool
+    n_starts: int
+    n_equivalent: int
+    principal_axes_mode: str
+    observations: ObservationSet
+    _model_q: NDArray[np.float64]
+    _model_omega: NDArray[np.float64]
+    _model_rows: NDArray[np.intp]
+
+    def __init__(self, **kw: Any) -> None:
         for k, v in kw.items():
             object.__setattr__(self, k, _frozen(v))
 
@@ -159,11 +226,11 @@ class FitResult:
         for kind, idx, width, sig in (("attitude", obs.att_idx, 3, obs.att_sigma[:, None] if len(obs.att_idx) else None),
                                       ("omega", obs.om_idx, 3, obs.om_sigma),
                                       ("axis", obs.ax_idx, 2, obs.ax_sigma[:, None] if len(obs.ax_idx) else None)):
-            n = width * len(idx)
-            if n:
-                residuals[kind] = res[start:start + n].reshape(-1, width) * sig
+            size = width * len(idx)
+            if size:
+                residuals[kind] = res[start:start + size].reshape(-1, width) * sig
                 residuals[kind + "_t"] = obs.t[idx]
-                start += n
+                start += size
         sigma = {}
         if len(obs.att_idx):
             sigma["attitude"] = float(np.median(obs.att_sigma))
@@ -185,7 +252,7 @@ class FitResult:
 
     # ------------------------------------------------------------------
     @property
-    def body(self):
+    def body(self) -> RigidBody:
         """The fitted body, a :class:`~eulerpoisson.RigidBody` with the trace-1 tensor in the observations' frame."""
         from ..model.body import RigidBody
 
@@ -198,12 +265,12 @@ class FitResult:
 
         return regime(self.inertia, self.omega0)
 
-    def attitude_error(self, attitude) -> np.ndarray:
+    def attitude_error(self, attitude: AttitudeLike) -> NDArray[np.float64]:
         """Body-frame rotation vector (radians) from ``attitude`` to the fitted ``attitude0`` (shape (3,))."""
         q = Attitude(attitude).as_quaternion() if not isinstance(attitude, Attitude) else attitude.as_quaternion()
         return log_quaternion(qmul(q * CONJUGATE, self.attitude0.as_quaternion()))
 
-    def predict(self, t, **options):
+    def predict(self, t: ArrayLike, **options: Any) -> Trajectory:
         """The fitted motion at times ``t`` (any, before or after the epoch), a :class:`~eulerpoisson.Trajectory`.
 
         Solved in closed form (``method="exact"``) unless ``options`` say
@@ -221,7 +288,7 @@ class FitResult:
         return out[0] if scalar else out
 
     # ------------------------------------------------------------------
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """Everything as plain Python (what :meth:`to_json` writes); NaN (undetermined) becomes None."""
         d = {
             "epoch": self.epoch,
@@ -249,7 +316,7 @@ class FitResult:
         }
         return _finite_or_none(d)
 
-    def to_json(self, path=None, *, indent: int = 2) -> str:
+    def to_json(self, path: str | os.PathLike[str] | None = None, *, indent: int = 2) -> str:
         """The result as JSON text; written atomically to ``path`` when given."""
         text = json.dumps(self.as_dict(), indent=indent, allow_nan=False) + "\n"
         if path is not None:
@@ -294,26 +361,32 @@ class FitResult:
     def __repr__(self) -> str:
         return f"<FitResult chi2={self.chi2:.4g} dof={self.dof} moments={np.round(self.principal_moments, 6).tolist()}>"
 
+    def _repr_html_(self) -> str:
+        """A compact HTML table for notebooks: :func:`eulerpoisson.util.htmlrepr.fit_html`."""
+        from ..util.htmlrepr import fit_html
+
+        return fit_html(self)
+
     # ------------------------------------------------------------------
-    def plot_residuals(self, ax=None):
+    def plot_residuals(self, ax: Axes | None = None) -> Figure:
         """Residuals over time, one panel per kind; returns the figure."""
         from .plots import plot_residuals
 
         return plot_residuals(self, ax=ax)
 
-    def plot_fit(self):
+    def plot_fit(self) -> Figure:
         """Fitted (lines) against observed (dots) attitude and rate; returns the figure."""
         from .plots import plot_fit
 
         return plot_fit(self)
 
-    def plot_polhode(self, ax=None):
+    def plot_polhode(self, ax: Axes | None = None) -> Figure:
         """The fitted polhode: the body angular momentum on its sphere, in the principal frame; returns the figure."""
         from .plots import plot_polhode
 
         return plot_polhode(self, ax=ax)
 
-    def save_plots(self, directory) -> list:
+    def save_plots(self, directory: str | os.PathLike[str]) -> list[Path]:
         """Write ``residuals.png``, ``fit.png`` and ``polhode.png`` into ``directory``; returns their paths."""
         from .plots import save_plots
 

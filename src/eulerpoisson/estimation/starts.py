@@ -182,6 +182,7 @@ def attitude_guesses(obs: ObservationSet, layout: Layout, I, omega0) -> list[np.
         return [qmul(qk, qrel * CONJUGATE)]
     # a direction only: the rotation taking the body axis to it, then quarter turns about it
     a, d = obs.axis, obs.ax_dir[0]
+    assert a is not None  # directions are observed, so is their body axis
     c = np.cross(a, d)
     s, cos = np.linalg.norm(c), float(a @ d)
     ang = np.arctan2(s, cos)
@@ -249,6 +250,7 @@ def _omega_grid(obs: ObservationSet):
         ang = np.arctan2(np.linalg.norm(np.cross(d0, d1)), d0 @ d1)
         rate = max(ang / dt, 1e-3)
         a = obs.axis
+        assert a is not None  # directions are observed, so is their body axis
         perp = np.cross(a, [1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.cross(a, [0.0, 1.0, 0.0])
         perp /= np.linalg.norm(perp)
         return [rate * perp + s * rate * a for s in (0.0, 1.0, -1.0, 3.0, -3.0)]

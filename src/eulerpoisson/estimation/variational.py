@@ -397,7 +397,7 @@ def _propagate_loops(I, J, dI, omega0, tau, order, tol, safety, max_steps, q, w,
 
 
 if USE_NUMBA:
-    from numba import njit
+    from ..util.jit import lazy_njit as njit  # made when numba is first used, not at import
 
     _propagate_numba = njit(cache=True, fastmath={"contract"})(_propagate_loops)
 else:  # pragma: no cover - depends on environment

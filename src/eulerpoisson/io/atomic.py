@@ -13,10 +13,10 @@ original error, e.g. :class:`FileNotFoundError`) with the message
 from __future__ import annotations
 
 import contextlib
-import glob
-import stat
 import errno as _errno
+import glob
 import os
+import stat
 import tempfile
 from pathlib import Path
 

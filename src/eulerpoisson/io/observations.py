@@ -115,9 +115,11 @@ import numbers
 import os
 import re
 from dataclasses import dataclass
+from dataclasses import field as dataclass_field
 from pathlib import Path
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import InvalidInputError, require
@@ -308,7 +310,7 @@ class _Settings:
     axis: np.ndarray | None = None
     principal_axes: str | None = None
     # where each came from, for messages ("omega_frame=" or "obs.toml: [observations] omega_frame")
-    origin: dict | None = None
+    origin: dict = dataclass_field(default_factory=dict)
 
 
 def _read_toml(p: Path, shown: str) -> tuple[Path, _Settings]:
@@ -504,10 +506,10 @@ def _read_csv(p: Path, shown: str) -> _Raw:
         (seq, parts), = euler.items()
         cols = tuple(f"euler_{seq}_{k}" for k in (1, 2, 3))
         group(cols, f"the Euler angles in sequence {seq!r}")
-        from ..attitude.core import _parse_seq
+        from ..attitude.core import parse_seq
 
         try:
-            _parse_seq(seq)
+            parse_seq(seq)
         except InvalidInputError as exc:
             raise InvalidInputError(f"{shown}: column {cols[0]!r}: invalid Euler sequence: {exc}") from None
     if has_q and seq is not None:
@@ -724,6 +726,7 @@ def _check_times(raw: _Raw) -> np.ndarray:
 
 
 def _check_finite_or_missing(raw: _Raw, b: _Block) -> None:
+    assert isinstance(b.values, np.ndarray)  # an (N, k) block: only a sigma can be a scalar
     inf = np.isinf(b.values)
     if inf.any():
         i, k = np.argwhere(inf)[0]
@@ -736,6 +739,7 @@ def _check_finite_or_missing(raw: _Raw, b: _Block) -> None:
 def _whole_rows(raw: _Raw, b: _Block, what: str) -> np.ndarray:
     """Rows given whole (True) or missing whole (False); a partly given row is an error."""
     _check_finite_or_missing(raw, b)
+    assert isinstance(b.values, np.ndarray)  # (checked there)
     given = np.isfinite(b.values)
     full = given.all(axis=1)
     partial = given.any(axis=1) & ~full
@@ -752,6 +756,7 @@ def _whole_rows(raw: _Raw, b: _Block, what: str) -> np.ndarray:
 def _unit_rows(raw: _Raw, b: _Block, what: str, noun: str) -> np.ndarray:
     full = _whole_rows(raw, b, what)
     v = b.values
+    assert isinstance(v, np.ndarray)  # (checked there)
     out = np.full_like(v, np.nan)
     if full.any():
         rows = v[full]
@@ -780,6 +785,7 @@ def _sigma(raw: _Raw, b: _Block, given: np.ndarray):
             raise InvalidInputError(f"{raw.file}, {b.what}: a sigma must be positive and finite, got {v!r}{b.unit}")
         return v * b.scale
     vals = b.values  # (N, 1) or (N, 3)
+    assert isinstance(vals, np.ndarray)  # the scalar returned above
     need = np.broadcast_to(given[:, None], vals.shape)
     bad = need & ~(np.isfinite(vals) & (vals > 0))
     if bad.any():
@@ -816,6 +822,7 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
         att_given = _whole_rows(raw, raw.euler, f"the Euler angles ({raw.euler_seq})")
         attitude = np.full((t.shape[0], 4), np.nan)
         if att_given.any():
+            assert raw.euler_seq is not None and isinstance(raw.euler.values, np.ndarray)  # read with the angles
             attitude[att_given] = quaternion_from_euler(raw.euler_seq, raw.euler.values[att_given], degrees=True)
 
     omega = None
@@ -848,7 +855,7 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
     frame = s.omega_frame or raw.omega_frame or "body"
 
     axis = None
-    if axis_direction is not None:
+    if raw.axis_direction is not None and axis_direction is not None:  # (the one is read from the other)
         if raw.axis is not None and s.axis is not None and not np.allclose(raw.axis, s.axis, rtol=0,
                                                                            atol=UNIT_TOLERANCE):
             raise InvalidInputError(
@@ -880,11 +887,13 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
         if s.sigma_attitude_deg is not None:
             attitude_sigma = s.sigma_attitude_deg * deg
         elif raw.attitude_sigma is not None:
+            assert att_given is not None  # set with attitude
             attitude_sigma = _sigma(raw, raw.attitude_sigma, att_given)
     if omega is not None:
         if s.sigma_omega is not None:
             omega_sigma = s.sigma_omega
         elif raw.omega_sigma is not None:
+            assert om_given is not None  # set with omega
             omega_sigma = _sigma(raw, raw.omega_sigma, om_given)
     if axis_direction is not None:
         if s.sigma_axis_deg is not None:
@@ -903,8 +912,8 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
 # ---------------------------------------------------------------------------
 # the entry point
 # ---------------------------------------------------------------------------
-def read_observations(path, *, sigma_attitude_deg=None, sigma_omega=None, sigma_axis_deg=None, omega_frame=None,
-                      axis=None) -> Observations:
+def read_observations(path: str | os.PathLike[str], *, sigma_attitude_deg: float | None = None, sigma_omega: float | None = None, sigma_axis_deg: float | None = None, omega_frame: str | None = None,
+                      axis: ArrayLike | None = None) -> Observations:
     """Read an observations file (``.csv``, ``.nc`` or ``.toml``; see the module notes for the columns).
 
     Parameters

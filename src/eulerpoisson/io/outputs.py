@@ -49,11 +49,12 @@ def file_kind(path) -> str | None:
         meta = p / "zarr.json" if (p / "zarr.json").exists() else (p / ".zattrs" if (p / ".zattrs").exists() else None)
         if meta is None and not (p / ".zgroup").exists():
             return "folder"
-        attrs = {}
+        attrs: dict = {}
         try:
-            with open(meta, encoding="utf-8") as fh:
-                doc = json.load(fh)
-            attrs = doc.get("attributes", doc) if isinstance(doc, dict) else {}
+            if meta is not None:  # a v2 group without attributes has none
+                with open(meta, encoding="utf-8") as fh:
+                    doc = json.load(fh)
+                attrs = doc.get("attributes", doc) if isinstance(doc, dict) else {}
         except (OSError, ValueError, TypeError):
             pass
         if "sweep_format_version" in attrs:
@@ -131,7 +132,7 @@ def check_output(path, writes: str, *, overwrite: bool = False, inputs=(), flag:
                           f"({flag} replaces only an output of the same kind)")
 
 
-def _pid_alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -158,7 +159,7 @@ class OutputLock:
         self.lock = p.with_name(f".{p.name}.lock")
         self._fd = None
 
-    def __enter__(self) -> "OutputLock":
+    def __enter__(self) -> OutputLock:
         from .atomic import write_error
 
         try:
@@ -177,7 +178,7 @@ class OutputLock:
                     pid = int(self.lock.read_text().strip() or "0")
                 except (OSError, ValueError):
                     pid = 0
-                if pid and pid != os.getpid() and _pid_alive(pid):
+                if pid and pid != os.getpid() and pid_alive(pid):
                     raise OutputError(f"{self.path} is being written by another process (pid {pid}); wait for it "
                                       f"to finish, or write to another file") from None
                 with contextlib.suppress(OSError):

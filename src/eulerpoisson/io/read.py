@@ -41,11 +41,19 @@ from __future__ import annotations
 import json
 import os
 import threading
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import EulerPoissonError, InvalidInputError, require
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from ..trajectory import Trajectory
 
 __all__ = ["open_trajectory", "LazyTrajectory", "StoredArray", "file_format", "NETCDF3_MAGIC", "HDF5_MAGIC"]
 
@@ -62,7 +70,7 @@ def _is_zarr_store(path: Path) -> bool:
     return path.is_dir() and any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zattrs"))
 
 
-def file_format(path) -> str:
+def file_format(path: str | os.PathLike[str]) -> str:
     """The format of a trajectory file by its content: ``"zarr"``, ``"netcdf4"``, ``"netcdf3"`` or ``"unknown"``."""
     p = Path(os.fsdecode(path))
     if p.is_dir():
@@ -84,7 +92,7 @@ def netcdf_engine(path) -> str:
     return "scipy" if file_format(path) == "netcdf3" else "h5netcdf"
 
 
-def open_trajectory(path):
+def open_trajectory(path: str | os.PathLike[str]) -> Trajectory | LazyTrajectory:
     """Open a trajectory file of any of our formats (see the module notes).
 
     Parameters
@@ -117,6 +125,8 @@ def open_trajectory(path):
 
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
+    if isinstance(path, bytes):
+        path = os.fsdecode(path)  # named as text in the messages below, not b'...'
     p = Path(os.fsdecode(path))
     if not p.exists():
         raise FileNotFoundError(f"no such file: {path}")
@@ -359,7 +369,7 @@ class StoredArray:
     ``a[-1]``); ``numpy.asarray(a)`` reads everything.
     """
 
-    def __init__(self, arr, batch_shape: tuple):
+    def __init__(self, arr: Any, batch_shape: tuple[int, ...]) -> None:
         self._arr = arr
         self._bshape = tuple(batch_shape)
         shp = tuple(arr.shape)
@@ -367,7 +377,7 @@ class StoredArray:
         self.dtype = np.dtype(arr.dtype)
         self.ndim = len(self.shape)
         self.chunks = tuple(getattr(arr, "chunks", shp))
-        self._direct = None  # the direct chunk reader (False: zarr reads everything)
+        self._direct: _DirectChunks | Literal[False] | None = None  # the direct chunk reader (False: zarr reads everything)
 
     def __len__(self) -> int:
         return self.shape[0]
@@ -400,7 +410,7 @@ class StoredArray:
             return x.reshape(self._bshape + x.shape[1:])
         return np.asarray(self._arr[sl])
 
-    def __getitem__(self, index):
+    def __getitem__(self, index: Any) -> NDArray[np.float64]:
         if not self._bshape:
             return np.asarray(self._arr[index])
         return np.asarray(self)[index]  # batches are small stores in practice
@@ -460,7 +470,7 @@ def ordered_map(fn, items, workers: int | None = None):
                 f.cancel()
 
 
-def _zarr_group(path: Path):
+def zarr_group(path: Path):
     import warnings
 
     zarr = require("zarr", "dask")
@@ -508,20 +518,20 @@ class LazyTrajectory:
 
     lazy = True
 
-    def __init__(self, path):
+    def __init__(self, path: str | os.PathLike[str]) -> None:
         from ..model.body import RigidBody
         from ..model.equations import Model
-        from ..trajectory import FORMAT_VERSION, _format_version, _json_attr, _read_torques
+        from ..trajectory import FORMAT_VERSION, format_version, json_attr, read_torques
 
         self.path = Path(path)
-        g = _zarr_group(self.path)
+        g = zarr_group(self.path)
         self._group = g
         attrs = dict(g.attrs)
         names = set(g.array_keys()) if hasattr(g, "array_keys") else set(g.keys())
         ver = attrs.get("eulerpoisson_format_version")
         if ver is None or "quaternion" not in names or "omega" not in names:
             raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory store")
-        ver = _format_version(path, ver)
+        ver = format_version(path, ver)
         if ver > FORMAT_VERSION:
             raise EulerPoissonError(
                 f"{path} has format version {ver}, newer than this eulerpoisson ({FORMAT_VERSION}); upgrade the package"
@@ -531,16 +541,16 @@ class LazyTrajectory:
             raise InvalidInputError(f"{path}: malformed eulerpoisson trajectory store, variable(s) {missing} missing")
 
         class _Attrs:  # what the NetCDF helpers expect: ds.attrs
-            pass
+            attrs: dict
 
         ds = _Attrs()
         ds.attrs = attrs
-        bshape = _json_attr(path, ds, "batch_shape", "[]", list)
+        bshape = json_attr(path, ds, "batch_shape", "[]", list)
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
             raise InvalidInputError(f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}")
         self.batch_shape = tuple(bshape)
-        self.options = _json_attr(path, ds, "method_options", "{}", dict)
-        self.stats = _json_attr(path, ds, "stats", "{}", dict)
+        self.options = json_attr(path, ds, "method_options", "{}", dict)
+        self.stats = json_attr(path, ds, "stats", "{}", dict)
         self.method = str(attrs.get("method", ""))
         tarr = g["time"]
         if len(tarr.shape) != 1:
@@ -570,7 +580,7 @@ class LazyTrajectory:
                 )
             else:
                 body = RigidBody(inertia, name=None if name is None else str(name), allow_unphysical=True)
-            self.model = Model(body, _read_torques(path, ds))
+            self.model = Model(body, read_torques(path, ds))
         except (InvalidInputError, TypeError) as exc:
             raise type(exc)(f"{path}: {exc}") from exc
         self.body = body
@@ -612,7 +622,7 @@ class LazyTrajectory:
                 f"{worst:.9g}; we write norm 1 within {UNIT_QUATERNION_TOLERANCE:g}): the store was modified or is not ours"
             )
 
-    def read(self, a: int = 0, b: int | None = None, step: int = 1):
+    def read(self, a: int = 0, b: int | None = None, step: int = 1) -> Trajectory:
         """The samples ``a:b:step`` as an in-memory :class:`~eulerpoisson.trajectory.Trajectory`.
 
         Raises
@@ -634,8 +644,8 @@ class LazyTrajectory:
             )
         return Trajectory(t, q, w, self.body, self.method, self.options, self.stats, torque=list(self.model.torques))
 
-    def read_arrays(self, names, a: int = 0, b: int | None = None, step: int = 1, *,
-                    scratch: dict | None = None) -> dict:
+    def read_arrays(self, names: Iterable[str], a: int = 0, b: int | None = None, step: int = 1, *,
+                    scratch: dict | None = None) -> dict[str, NDArray[np.float64]]:
         """The raw arrays ``names`` (``"time"`` and stored variables) at samples ``a:b:step``, without a Trajectory.
 
         The cheapest way through a long store: only the named variables are
@@ -669,15 +679,15 @@ class LazyTrajectory:
             out[nm] = x
         return out
 
-    def iter_arrays(self, names, size: int | None = None, ranges=None):
+    def iter_arrays(self, names: Iterable[str], size: int | None = None, ranges: Iterable[tuple[int, int]] | None = None) -> Iterator[dict[str, NDArray[np.float64]]]:
         """:meth:`read_arrays` piece by piece (``size`` samples, whole Zarr chunks; or the given ``(a, b)`` ranges).
 
         The next pieces are read in background threads while the caller works on the current one.
         """
         return self.map_arrays(names, None, size, ranges)
 
-    def map_arrays(self, names, fn=None, size: int | None = None, ranges=None, workers: int | None = None,
-                   reuse: bool = False):
+    def map_arrays(self, names: Iterable[str], fn: Callable[[dict[str, NDArray[np.float64]]], Any] | None = None, size: int | None = None, ranges: Iterable[tuple[int, int]] | None = None, workers: int | None = None,
+                   reuse: bool = False) -> Iterator[Any]:
         """``fn(piece)`` for the pieces of :meth:`iter_arrays`, in order, each read and computed in a thread.
 
         The chunks are decoded in parallel (numcodecs and NumPy release the
@@ -697,7 +707,7 @@ class LazyTrajectory:
 
         return ordered_map(task, ranges, workers)
 
-    def __getitem__(self, index):
+    def __getitem__(self, index: Any) -> Trajectory:
         if isinstance(index, slice):
             return self.read(index.start or 0, index.stop, index.step or 1) if (index.step or 1) > 0 else \
                 self.load()[index]
@@ -723,7 +733,7 @@ class LazyTrajectory:
             return self.read(0, 0)
         return self.gather(idx)
 
-    def gather(self, idx):
+    def gather(self, idx: ArrayLike) -> Trajectory:
         """The samples ``idx`` (any integers in range, any order) as a Trajectory; each Zarr chunk is read once."""
         from ..trajectory import Trajectory
 
@@ -746,26 +756,26 @@ class LazyTrajectory:
         return Trajectory(t[inv], q[..., inv, :], w[..., inv, :], self.body, self.method, self.options, self.stats,
                           torque=list(self.model.torques))
 
-    def head(self, n: int = 1):
+    def head(self, n: int = 1) -> Trajectory:
         """The first ``n`` samples (a Trajectory)."""
         return self.read(0, min(n, self.T))
 
-    def tail(self, n: int = 1):
+    def tail(self, n: int = 1) -> Trajectory:
         """The last ``n`` samples (a Trajectory)."""
         return self.read(max(0, self.T - n), self.T)
 
-    def chunk_bounds(self, size: int | None = None):
+    def chunk_bounds(self, size: int | None = None) -> list[tuple[int, int]]:
         """``(a, b)`` sample ranges of ``size`` (default: the store's chunk) covering the store."""
         size = int(size or self.chunk)
         size = max(1, -(-size // self.chunk) * self.chunk)  # whole Zarr chunks
         return [(a, min(self.T, a + size)) for a in range(0, self.T, size)]
 
-    def iter_chunks(self, size: int | None = None):
+    def iter_chunks(self, size: int | None = None) -> Iterator[Trajectory]:
         """In-memory trajectories of consecutive pieces of the store, ``size`` samples each (whole Zarr chunks)."""
         for a, b in self.chunk_bounds(size):
             yield self.read(a, b)
 
-    def load(self, *, limit: int | None = LOAD_LIMIT):
+    def load(self, *, limit: int | None = LOAD_LIMIT) -> Trajectory:
         """The whole store as an in-memory Trajectory.
 
         Raises
@@ -797,7 +807,7 @@ class LazyTrajectory:
                           torque=list(self.model.torques))
         return both.drift()
 
-    def plot(self, kind: str = "omega", **kwargs):
+    def plot(self, kind: str = "omega", **kwargs: Any) -> Figure:
         """A picture of the stored trajectory, drawn chunk by chunk: :func:`eulerpoisson.viz.plots.plot`."""
         from ..viz import plots
 
@@ -806,3 +816,12 @@ class LazyTrajectory:
     def __repr__(self) -> str:
         b = f", batch_shape={self.batch_shape}" if self.batch_shape else ""
         return f"LazyTrajectory({str(self.path)!r}, method={self.method!r}, T={self.T}{b})"
+
+    def _repr_html_(self) -> str:
+        """HTML view for notebooks, drawn from a few samples spread over the store (a few chunks read, not the file).
+
+        See :func:`eulerpoisson.util.htmlrepr.trajectory_html`.
+        """
+        from ..util.htmlrepr import trajectory_html
+
+        return trajectory_html(self)

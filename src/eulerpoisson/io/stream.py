@@ -101,12 +101,22 @@ import shutil
 import sys
 import time as _time
 import warnings
-from datetime import datetime, timezone
+from collections.abc import Callable, Sequence
+from datetime import UTC, datetime
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import EulerPoissonError, InvalidInputError, require
+
+if TYPE_CHECKING:
+    from ..attitude.core import AttitudeLike
+    from ..model.body import RigidBody
+    from ..model.equations import Model
+    from ..model.torques import TorqueLike
+    from ..trajectory import Trajectory
 
 __all__ = ["TimeGrid", "solve_to_file", "solve_from", "partial_store", "TIME_VARIABLES"]
 
@@ -148,15 +158,15 @@ class TimeGrid:
     (5, [0.25, 0.5])
     """
 
-    def __init__(self, t0, t1, n):
+    def __init__(self, t0, t1, n) -> None:  # float, float, int: anything else is refused below
         for name, v in (("t0", t0), ("t1", t1)):
             if isinstance(v, bool) or not isinstance(v, numbers.Real):
                 raise TypeError(f"t: {name} must be a real number, got {type(v).__name__} {v!r}")
-            if not np.isfinite(v):
+            if not np.isfinite(v):  # type: ignore[call-overload]  # mypy types no numbers.Real as a float
                 raise InvalidInputError(f"t: {name} must be finite, got {v!r}")
         if isinstance(n, bool) or not isinstance(n, numbers.Integral):
-            if isinstance(n, numbers.Real) and float(n) == int(n):
-                n = int(n)
+            if isinstance(n, numbers.Real) and float(n) == int(n):  # type: ignore[call-overload]
+                n = int(n)  # type: ignore[call-overload]
             else:
                 raise TypeError(f"t: the number of samples n must be an integer, got {n!r}")
         if n < 1:
@@ -173,7 +183,13 @@ class TimeGrid:
     def shape(self) -> tuple[int]:
         return (self.n,)
 
-    def __getitem__(self, idx):
+    @overload
+    def __getitem__(self, idx: slice) -> NDArray[np.float64]: ...
+    @overload
+    def __getitem__(self, idx: int | np.integer) -> float: ...
+    @overload
+    def __getitem__(self, idx: ArrayLike) -> float | NDArray[np.float64]: ...
+    def __getitem__(self, idx: int | slice | ArrayLike) -> float | NDArray[np.float64]:
         if isinstance(idx, slice):
             a, b, s = idx.indices(self.n)
             i = np.arange(a, b, s, dtype=np.float64)
@@ -315,7 +331,7 @@ def _finished_run(path: Path):
         return None
 
 
-def partial_store(path) -> Path:
+def partial_store(path: str | os.PathLike[str]) -> Path:
     """The Zarr store where :func:`solve_to_file` keeps the chunks of an unfinished run to ``path``.
 
     Readable while the run is going on or after it was interrupted
@@ -417,7 +433,7 @@ def _shifted_torques(torques, t_start: float):
     InvalidInputError
         A time-dependent torque of a class that cannot be shifted.
     """
-    from ..model.torques import BodyTorque, CallableTorque, Gravity, GravityGradient, SpaceTorque
+    from ..model.torques import BodyTorque, CallableTorque, Gravity, GravityGradient, SpaceTorque, Torque
     from ..numerics.quaternion import qmul
 
     grads = [tq for tq in torques if isinstance(tq, GravityGradient)]
@@ -427,7 +443,7 @@ def _shifted_torques(torques, t_start: float):
             phi = np.asarray(tq.mean_motion, dtype=float) * t_start
             break
     turn = bool(np.any(phi != 0))
-    out = []
+    out: list[Torque] = []
     for tq in torques:
         if isinstance(tq, (GravityGradient, BodyTorque)):
             out.append(tq)
@@ -453,7 +469,7 @@ def _shifted_torques(torques, t_start: float):
     return out, phi
 
 
-def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, workers=None, **options):
+def solve_from(model: Model | RigidBody | ArrayLike, t: ArrayLike, t_start: float, q_start: ArrayLike, omega_start: ArrayLike, *, method: str, workers: int | None = None, **options: Any) -> Trajectory:
     r"""Continue a motion from its state at ``t_start`` to the (absolute) output times ``t``.
 
     The building block of long runs solved chunk by chunk: the model is
@@ -511,7 +527,7 @@ def solve_from(model, t, t_start: float, q_start, omega_start, *, method: str, w
     return Trajectory(t, q, tr.omega, model.body, tr.method, tr.options, tr.stats, torque=list(model.torques))
 
 
-def _torque_fingerprint(model) -> list:
+def torque_fingerprint(model) -> list:
     out = []
     for tq in model.torques:
         try:
@@ -539,22 +555,22 @@ def _flatten_batch(a: np.ndarray, bshape: tuple) -> np.ndarray:
 
 
 def solve_to_file(
-    body,
-    t,
-    path,
+    body: RigidBody | Model | ArrayLike,
+    t: TimeGrid | tuple[float, float, int] | ArrayLike,
+    path: str | os.PathLike[str],
     *,
-    omega0=None,
-    m0=None,
-    attitude0=None,
-    torque=None,
+    omega0: ArrayLike | None = None,
+    m0: ArrayLike | None = None,
+    attitude0: AttitudeLike | None = None,
+    torque: TorqueLike = None,
     method: str = "exact",
     chunk: int = 100_000,
-    progress=None,
+    progress: bool | Callable[[int, int], Any] | None = None,
     resume: bool = False,
     overwrite: bool = False,
-    variables=None,
-    workers=None,
-    **options,
+    variables: Sequence[str] | None = None,
+    workers: int | None = None,
+    **options: Any,
 ) -> Path:
     r"""Solve the motion at very many output times and stream it to a Zarr store.
 
@@ -639,17 +655,17 @@ def solve_to_file(
     sample; quaternion signs are made continuous across chunk boundaries
     (as :class:`~eulerpoisson.trajectory.Trajectory` does within one).
     """
-    from ..util.validate import as_scalar
     from ..solvers import get_method, make_problem, solve
     from ..solvers.parallel import check_workers
     from ..solvers.registry import check_supported
     from ..trajectory import Trajectory
+    from ..util.validate import as_scalar
 
     zarr = require("zarr", "dask")
     require("xarray", "io")
 
     path = Path(path)
-    chunk = as_scalar(chunk, "chunk", positive=True, integer=True)
+    chunk = int(as_scalar(chunk, "chunk", positive=True, integer=True))
     if variables is None:
         variables = list(TIME_VARIABLES)
     else:
@@ -694,7 +710,7 @@ def solve_to_file(
         "variables": variables,
     }
     if not model.is_free:  # (free runs keep the fingerprint of earlier versions: their partial runs resume)
-        fingerprint["torque"] = _torque_fingerprint(model)
+        fingerprint["torque"] = torque_fingerprint(model)
 
     if overwrite:
         _check_replaceable(path)  # before any work, not after
@@ -785,7 +801,10 @@ def solve_to_file(
 
     n_done = sum(min(chunk, n - k * chunk) for k in done)
     try:
-        with ProgressDisplay(progress, n, f"solving {method} to {path.name}") as bar:
+        from ..util.jit import whole_run
+
+        # one choice of compiled kernels or NumPy for the whole run, not per chunk
+        with ProgressDisplay(progress, n, f"solving {method} to {path.name}") as bar, whole_run(n_times=n):
             bar.update(n_done)
             for k in range(nchunks):
                 a, b = k * chunk, min(n, (k + 1) * chunk)
@@ -805,6 +824,7 @@ def solve_to_file(
                     tr = solve(model, tc, omega0=problem.omega0, attitude0=problem.q0, method=method,
                                workers=workers, **options)
                 else:
+                    assert prev_t is not None and prev_w is not None  # set with prev_q
                     tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, workers=workers, **options)
                 q = tr.quaternion
                 if prev_q is not None:
@@ -822,7 +842,7 @@ def solve_to_file(
                             if isinstance(val, numbers.Number) and not isinstance(val, bool)
                             and key not in ("wall_time", "threads")}
                 _mark_done(work, k, {"wall_time": wall, "stats": counters,
-                                     "written": datetime.now(timezone.utc).isoformat()})
+                                     "written": datetime.now(UTC).isoformat()})
                 prev_q = q[..., -1, :]
                 prev_w = tr.omega[..., -1, :]
                 prev_t = float(tc[-1])
@@ -850,7 +870,7 @@ def solve_to_file(
     with _quiet_zarr():
         g.attrs.update({
             "stats": json.dumps(totals, default=float, sort_keys=True),
-            "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} streamed by "
+            "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} streamed by "
             f"eulerpoisson {template.attrs['eulerpoisson_version']} in {nchunks} chunks of {chunk}",
             # the arguments of the run: a later resume=True with the same ones finds it complete
             "eulerpoisson_run": json.dumps(fingerprint, sort_keys=True, default=float),

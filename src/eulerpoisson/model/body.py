@@ -13,10 +13,13 @@ Paper eq. 1.1-1.3, 1.5, 1.25. L. D. Landau and E. M. Lifshitz, *Mechanics*, §32
 
 from __future__ import annotations
 
-import numpy as np
+from typing import Any
 
-from ..util.validate import describe_value, as_bool, as_float_array
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
 from ..errors import InvalidInertiaError, InvalidInputError
+from ..util.validate import as_bool, as_float_array, describe_value
 
 __all__ = ["RigidBody"]
 
@@ -121,7 +124,7 @@ def check_moments(ev: np.ndarray, name: str = "inertia", triangle: bool = True) 
         )
 
 
-def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True):
+def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     check_moments(a, name, triangle)
     ev = a.copy()
     I = ev[..., :, None] * np.eye(3)
@@ -129,7 +132,7 @@ def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True):
     return I, ev, P
 
 
-def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True):
+def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     check_tensor(a, name)
     # very large or very small tensors are scaled by a power of two (exact) so that neither the
     # symmetrization nor the eigen-decomposition overflows or underflows; ordinary ones are untouched
@@ -229,7 +232,7 @@ class RigidBody:
     'oblate'
     """
 
-    def __init__(self, inertia, *, name: str | None = None, allow_unphysical: bool = False):
+    def __init__(self, inertia: ArrayLike, *, name: str | None = None, allow_unphysical: bool = False) -> None:
         a = as_float_array(inertia, "inertia")
         triangle = not as_bool(allow_unphysical, "allow_unphysical")
         if a.ndim >= 2 and a.shape[-2:] == (3, 3):
@@ -245,7 +248,7 @@ class RigidBody:
             )
         self._set(I, ev, P, name)
 
-    def _set(self, I, ev, P, name):
+    def _set(self, I: NDArray[np.float64], ev: NDArray[np.float64], P: NDArray[np.float64], name: str | None) -> None:
         self.inertia = I
         self.principal_moments = ev
         self.principal_axes = P
@@ -255,7 +258,7 @@ class RigidBody:
         self.center_of_mass: np.ndarray | None = None
 
     @classmethod
-    def from_moments(cls, moments, *, name: str | None = None, allow_unphysical: bool = False) -> "RigidBody":
+    def from_moments(cls, moments: ArrayLike, *, name: str | None = None, allow_unphysical: bool = False) -> RigidBody:
         """A body (or batch) given by principal moments only, shape (..., 3).
 
         Unambiguous where ``RigidBody(moments)`` is not: a batch of moments of
@@ -291,7 +294,7 @@ class RigidBody:
 
     # ------------------------------------------------------------------
     @classmethod
-    def from_particles(cls, masses, positions, *, name: str | None = None) -> "RigidBody":
+    def from_particles(cls, masses: ArrayLike, positions: ArrayLike, *, name: str | None = None) -> RigidBody:
         r"""A body made of point masses (the system of the paper's eq. 1.1).
 
         The centre of mass :math:`\mathbf C = \sum m_N\mathbf y_N/\sum m_N` is
@@ -379,7 +382,7 @@ class RigidBody:
         body.center_of_mass = c
         return body
 
-    def in_principal_frame(self) -> "RigidBody":
+    def in_principal_frame(self) -> RigidBody:
         r"""The same body described in its principal frame.
 
         Returns a body whose inertia tensor is ``diag(principal_moments)``;
@@ -406,13 +409,13 @@ class RigidBody:
         return self.principal_moments.shape[:-1]
 
     @property
-    def inertia_inv(self) -> np.ndarray:
+    def inertia_inv(self) -> NDArray[np.float64]:
         r"""Inverse inertia tensor :math:`I^{-1} = P\,\mathrm{diag}(1/I_k)P^T`, shape (..., 3, 3)."""
         P = self.principal_axes
         return P @ ((1.0 / self.principal_moments)[..., :, None] * np.swapaxes(P, -1, -2))
 
     @property
-    def mass_matrix(self) -> np.ndarray:
+    def mass_matrix(self) -> NDArray[np.float64]:
         r"""The paper's mass matrix :math:`g_{ij} = \sum_N m_N x^i_N x^j_N`, shape (..., 3, 3).
 
         Obtained from the inertia tensor by inverting :math:`I = \mathrm{tr}(g)\mathbf 1 - g`:
@@ -440,7 +443,7 @@ class RigidBody:
         return bool(x) if x.ndim == 0 else x
 
     @property
-    def is_sphere(self):
+    def is_sphere(self) -> bool | NDArray[np.bool_]:
         """All three principal moments equal (within ``DEGENERACY_RTOL``).
 
         A bool for one body, a boolean array of the batch shape otherwise.
@@ -449,7 +452,7 @@ class RigidBody:
         return self._flag(self._rel_close(I[..., 0], I[..., 1]) & self._rel_close(I[..., 1], I[..., 2]))
 
     @property
-    def is_symmetric(self):
+    def is_symmetric(self) -> bool | NDArray[np.bool_]:
         """At least two principal moments equal: a symmetric top (or a sphere).
 
         A bool for one body, a boolean array of the batch shape otherwise.
@@ -458,7 +461,7 @@ class RigidBody:
         return self._flag(self._rel_close(I[..., 0], I[..., 1]) | self._rel_close(I[..., 1], I[..., 2]))
 
     @property
-    def is_planar(self):
+    def is_planar(self) -> bool | NDArray[np.bool_]:
         """The triangle inequality is an equality, ``I1 + I2 = I3``: all mass in one plane.
 
         A bool for one body, a boolean array of the batch shape otherwise.
@@ -474,7 +477,7 @@ class RigidBody:
         return bool(np.all(self.inertia - self.inertia * np.eye(3) == 0))
 
     @property
-    def kind(self):
+    def kind(self) -> str | NDArray[np.str_]:
         """``'sphere'``, ``'prolate'`` (rod-like: the unique moment is the smallest),
         ``'oblate'`` (disk-like: the unique moment is the largest) or ``'asymmetric'``.
 
@@ -487,7 +490,7 @@ class RigidBody:
         return str(out) if out.ndim == 0 else out
 
     # ------------------------------------------------------------------
-    def angular_momentum(self, omega) -> np.ndarray:
+    def angular_momentum(self, omega: ArrayLike) -> NDArray[np.float64]:
         r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega` (eq. 1.24).
 
         Parameters
@@ -507,7 +510,7 @@ class RigidBody:
         w = as_float_array(omega, "omega", (3,))
         return np.einsum("...ij,...j->...i", self.inertia, w)
 
-    def angular_velocity(self, M) -> np.ndarray:
+    def angular_velocity(self, M: ArrayLike) -> NDArray[np.float64]:
         r"""Body angular velocity :math:`\boldsymbol\Omega = I^{-1}\mathbf M` (eq. 1.24).
 
         Parameters
@@ -527,7 +530,7 @@ class RigidBody:
         M = as_float_array(M, "M", (3,))
         return np.einsum("...ij,...j->...i", self.inertia_inv, M)
 
-    def energy(self, omega) -> np.ndarray:
+    def energy(self, omega: ArrayLike) -> NDArray[np.float64]:
         r"""Kinetic energy :math:`E = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega` (eq. 1.25).
 
         Parameters
@@ -551,7 +554,7 @@ class RigidBody:
             raise InvalidInputError(f"energy overflows float64 (max |omega| = {float(np.max(np.abs(w))):.3g}); rescale omega")
         return E
 
-    def to_principal(self, v) -> np.ndarray:
+    def to_principal(self, v: ArrayLike) -> NDArray[np.float64]:
         """Components of body-frame vectors in the principal frame: ``P^T v``.
 
         Parameters
@@ -570,7 +573,7 @@ class RigidBody:
         v = as_float_array(v, "v", (3,))
         return np.einsum("...ji,...j->...i", self.principal_axes, v)
 
-    def from_principal(self, v) -> np.ndarray:
+    def from_principal(self, v: ArrayLike) -> NDArray[np.float64]:
         """Body-frame components of principal-frame vectors: ``P v``.
 
         Parameters
@@ -589,7 +592,7 @@ class RigidBody:
         v = as_float_array(v, "v", (3,))
         return np.einsum("...ij,...j->...i", self.principal_axes, v)
 
-    def __getitem__(self, idx) -> "RigidBody":
+    def __getitem__(self, idx: Any) -> RigidBody:
         """Bodies of the batch (indexes the batch axes only, never the tensor axes)."""
         if self.batch_shape == ():
             raise TypeError("a single RigidBody cannot be indexed")
@@ -611,3 +614,9 @@ class RigidBody:
             nm = f"{self.name!r}, " if self.name else ""
             return f"RigidBody({nm}principal_moments=[{mom}]{diag}, kind={self.kind!r})"
         return f"RigidBody(batch_shape={self.batch_shape})"
+
+    def _repr_html_(self) -> str:
+        """A compact HTML table for notebooks (a batch summarized): :func:`eulerpoisson.util.htmlrepr.body_html`."""
+        from ..util.htmlrepr import body_html
+
+        return body_html(self)

@@ -37,15 +37,25 @@ Acta Math. 12 (1889) 177-232. D. N. Goryachev (1900), S. A. Chaplygin (1901).
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..attitude.core import matrix_from_unit_quaternion
 from ..errors import InvalidInputError
 from ..numerics.quaternion import qmul_components
 from .body import RigidBody
-from .torques import Gravity, GravityGradient, PolynomialTorque, Torque, as_torques
+from .torques import (
+    CallableTorque,
+    Gravity,
+    GravityGradient,
+    PolynomialTorque,
+    SpaceTorque,
+    Torque,
+    TorqueLike,
+    as_torques,
+)
 
 __all__ = ["Model", "LagrangeTop", "as_model"]
 
@@ -104,7 +114,7 @@ class Model:
     (False, True)
     """
 
-    def __init__(self, body, torque=None):
+    def __init__(self, body: RigidBody | ArrayLike, torque: TorqueLike = None) -> None:
         if isinstance(body, Model):
             raise TypeError("body is already a Model; pass its body and torques, or the Model itself to solve()")
         if not isinstance(body, RigidBody):
@@ -148,7 +158,13 @@ class Model:
     def __repr__(self) -> str:
         return f"Model({self.body!r}, torque={list(self.torques)!r})"
 
-    def element(self, index: tuple[int, ...]) -> "Model":
+    def _repr_html_(self) -> str:
+        """A compact HTML table for notebooks: :func:`eulerpoisson.util.htmlrepr.model_html`."""
+        from ..util.htmlrepr import model_html
+
+        return model_html(self)
+
+    def element(self, index: tuple[int | np.integer, ...]) -> Model:
         """The model of one element of a batch: ``index`` is a full index into a batch shape that this
         model's batch shape broadcasts to (numpy's right-aligned broadcasting rules)."""
         index = tuple(int(i) for i in index)
@@ -164,7 +180,7 @@ class Model:
     # ------------------------------------------------------------------
     # the vector field
     # ------------------------------------------------------------------
-    def torque(self, t, q, omega) -> np.ndarray:
+    def torque(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
         r"""Total body-frame torque :math:`\boldsymbol\tau(t, q, \boldsymbol\Omega)`, shape (..., 3).
 
         Parameters
@@ -183,12 +199,12 @@ class Model:
         inertia = self.body.inertia
         for tq in self.torques:
             if tq.kind == "callable":
-                out = out + tq.evaluate(t, R, omega, inertia, q=q)
+                out = out + cast(CallableTorque, tq).evaluate(t, R, omega, inertia, q=q)
             else:
                 out = out + tq.evaluate(t, R, omega, inertia)
         return out
 
-    def omega_dot(self, t, q, omega) -> np.ndarray:
+    def omega_dot(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
         r""":math:`\dot{\boldsymbol\Omega} = I^{-1}\big((I\boldsymbol\Omega)\times\boldsymbol\Omega + \boldsymbol\tau\big)`, shape (..., 3)."""
         omega = np.asarray(omega, dtype=float)
         M = _mv(self.body.inertia, omega)
@@ -197,7 +213,7 @@ class Model:
             rhs = rhs + self.torque(t, q, omega)
         return _mv(self.body.inertia_inv, rhs)
 
-    def rhs(self, t, q, omega) -> tuple[np.ndarray, np.ndarray]:
+    def rhs(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         r"""The vector field :math:`(\dot q, \dot{\boldsymbol\Omega})`.
 
         Parameters
@@ -236,7 +252,7 @@ class Model:
     # ------------------------------------------------------------------
     # energy and integrals
     # ------------------------------------------------------------------
-    def potential(self, t, q) -> np.ndarray:
+    def potential(self, t: ArrayLike, q: ArrayLike) -> NDArray[np.float64]:
         r"""Sum of the potentials :math:`U(t, R)` of the conservative torques, shape (...).
 
         Torques without a potential contribute nothing (see :attr:`is_conservative`).
@@ -251,7 +267,7 @@ class Model:
                 U = U + tq.potential(t, R, self.body.inertia)
         return U
 
-    def energy(self, t, q, omega) -> np.ndarray:
+    def energy(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
         r"""Kinetic plus potential energy :math:`\tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega + U`, shape (...)."""
         omega = np.asarray(omega, dtype=float)
         E = 0.5 * _dot(omega, _mv(self.body.inertia, omega))
@@ -290,7 +306,7 @@ class Model:
         e2 = np.cross(e3, e1)
         F = np.stack([e1, e2, e3], axis=1)  # body = F @ frame
         c = F.T @ grav.center_of_mass
-        if abs(c[2]) > SYMMETRY_RTOL * max(np.linalg.norm(c), 1e-300) or np.linalg.norm(c) == 0:
+        if abs(c[2]) > SYMMETRY_RTOL * max(float(np.linalg.norm(c)), 1e-300) or np.linalg.norm(c) == 0:
             return None
         gn = float(np.linalg.norm(grav.g))
         kappa = float(grav.mass) * gn / float(small)
@@ -302,54 +318,65 @@ class Model:
         A spherical body (three equal moments) with its centre of mass off
         the origin is a Lagrange top about the axis through the centre of
         mass; a centre of mass at the origin is a free body under no torque
-        (not reported here).
+        (not reported here). For a batch the fields have the batch shape
+        (``frame``: ``(*batch, 3, 3)``), computed element by element in
+        vectorized arithmetic (the same bits for an element alone or in any
+        batch); None unless every element is a Lagrange top.
         """
-        if len(self.torques) != 1 or not isinstance(self.torques[0], Gravity) or self.batch_shape:
+        if len(self.torques) != 1 or not isinstance(self.torques[0], Gravity):
             return None
         grav = self.torques[0]
-        c = grav.center_of_mass
-        cn = float(np.linalg.norm(c))
-        if cn == 0.0:
+        shape = tuple(self.batch_shape)
+        c = np.broadcast_to(np.asarray(grav.center_of_mass, dtype=float), shape + (3,))
+        c0, c1, c2 = c[..., 0], c[..., 1], c[..., 2]
+        cn = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        if np.any(cn == 0.0):
             return None
-        ev = self.body.principal_moments
-        P = self.body.principal_axes
-        scale = float(np.max(ev))
-        chat = c / cn
-        Ic = self.body.inertia @ chat
+        ev = np.broadcast_to(self.body.principal_moments, shape + (3,))
+        P = np.broadcast_to(self.body.principal_axes, shape + (3, 3))
+        inertia = np.broadcast_to(self.body.inertia, shape + (3, 3))
+        tol = SYMMETRY_RTOL * np.max(ev, axis=-1)
+        chat = c / cn[..., None]
+        # explicit sums of three terms: no reduction whose order could depend on the batch
+        Ic = inertia[..., 0] * chat[..., 0, None] + inertia[..., 1] * chat[..., 1, None] + inertia[..., 2] * chat[..., 2, None]
+        C = chat[..., 0] * Ic[..., 0] + chat[..., 1] * Ic[..., 1] + chat[..., 2] * Ic[..., 2]
+        d = Ic - C[..., None] * chat
         # the centre of mass must lie on an eigenvector whose eigenvalue is simple or the body a sphere,
-        # and the other two moments must be equal
-        C = float(chat @ Ic)
-        if np.linalg.norm(Ic - C * chat) > SYMMETRY_RTOL * scale:
+        if np.any(np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2) > tol):
             return None
-        others = np.sort(ev)
-        # remove the eigenvalue C once, the remaining two must be equal
-        k = int(np.argmin(np.abs(ev - C)))
-        rest = np.delete(ev, k)
-        if abs(rest[0] - rest[1]) > SYMMETRY_RTOL * scale:
+        # and the other two moments (the eigenvalue C removed once) must be equal
+        k = np.argmin(np.abs(ev - C[..., None]), axis=-1)
+        rest = ev[np.arange(3) != k[..., None]].reshape(shape + (2,))
+        if np.any(np.abs(rest[..., 0] - rest[..., 1]) > tol):
             return None
-        A = float(0.5 * (rest[0] + rest[1]))
-        # frame: e3 = chat, e1 any unit vector perpendicular to it
-        trial = P[:, int(np.argmax(np.abs(ev - C)))] if np.ptp(others) > SYMMETRY_RTOL * scale else np.eye(3)[int(np.argmin(np.abs(chat)))]
-        e1 = trial - (trial @ chat) * chat
-        e1 /= np.linalg.norm(e1)
+        A = 0.5 * (rest[..., 0] + rest[..., 1])
+        # frame: e3 = chat, e1 any unit vector perpendicular to it (the principal axis farthest from C,
+        # or for a sphere the coordinate axis least aligned with chat)
+        j = np.argmax(np.abs(ev - C[..., None]), axis=-1)
+        from_axes = np.take_along_axis(P, j[..., None, None], axis=-1)[..., 0]
+        from_eye = np.eye(3)[np.argmin(np.abs(chat), axis=-1)]
+        trial = np.where((np.ptp(ev, axis=-1) > tol)[..., None], from_axes, from_eye)
+        e1 = trial - (trial[..., 0] * chat[..., 0] + trial[..., 1] * chat[..., 1] + trial[..., 2] * chat[..., 2])[..., None] * chat
+        e1 = e1 / np.sqrt(e1[..., 0] ** 2 + e1[..., 1] ** 2 + e1[..., 2] ** 2)[..., None]
         e2 = np.cross(chat, e1)
-        F = np.stack([e1, e2, chat], axis=1)
-        return LagrangeTop(A=np.asarray(A), C=np.asarray(C), mass=np.asarray(grav.mass, float), ell=np.asarray(cn),
-                           g=np.asarray(grav.g, float), frame=F)
+        F = np.stack([e1, e2, chat], axis=-1)
+        mass = np.array(np.broadcast_to(np.asarray(grav.mass, dtype=float), shape))
+        g = np.array(np.broadcast_to(np.asarray(grav.g, dtype=float), shape + (3,)))
+        return LagrangeTop(A=np.asarray(A), C=np.asarray(C), mass=mass, ell=np.asarray(cn), g=g, frame=F)
 
-    def integrals(self, t, q, omega) -> dict[str, np.ndarray]:
+    def integrals(self, t: ArrayLike, q: ArrayLike, omega: ArrayLike) -> dict[str, NDArray[np.float64]]:
         r"""The conserved quantities of the model along a trajectory.
 
         Parameters
         ----------
         t : ndarray, shape (T,)
-        q : ndarray, shape (*batch, T, 4)
+        q : ndarray, shape ``(*batch, T, 4)``
             Unit quaternions; the model's batch shape broadcasts to ``batch``.
-        omega : ndarray, shape (*batch, T, 3)
+        omega : ndarray, shape ``(*batch, T, 3)``
 
         Returns
         -------
-        dict of str to ndarray, shape (*batch, T)
+        dict of str to ndarray, shape ``(*batch, T)``
             Free body: ``energy``, ``m_x``, ``m_y``, ``m_z`` (spatial angular
             momentum) and ``m_norm``. Heavy top (gravity along one direction):
             ``energy`` and ``m_vertical`` (:math:`\mathbf m\cdot\hat{\mathbf g}`),
@@ -377,8 +404,6 @@ class Model:
         Borisov and Mamaev (2018), §2.2-2.3; Kovalevskaya (1889); Goryachev (1900),
         Chaplygin (1901); Beletsky (1966), ch. 1 (the Jacobi integral).
         """
-        from .torques import SpaceTorque
-
         t = np.asarray(t, dtype=float)
         q = np.asarray(q, dtype=float)
         omega = np.asarray(omega, dtype=float)
@@ -402,7 +427,7 @@ class Model:
         kinds = {type(tq) for tq in self.torques}
         if kinds == {Gravity}:
             U = 0.0
-            for tq in self.torques:
+            for tq in cast(tuple[Gravity, ...], self.torques):
                 U = U - _dot(per_body(tq.g, 1), _mv(R, per_body(tq.moment_arm, 1)))
             out["energy"] = kinetic + U
             ghat = self._gravity_direction()
@@ -432,21 +457,21 @@ class Model:
                                     - kappa * gamma[..., 2] * (c2[0] * w[..., 0] + c2[1] * w[..., 1]))
             return out
         if kinds == {GravityGradient} and len(self.torques) == 1:
-            nu = per_body(self.torques[0].mean_motion, 0)
+            nu = per_body(cast(GravityGradient, self.torques[0]).mean_motion, 0)
             phase = t * nu
             rhat = np.stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)], -1)
             r = np.einsum("...ji,...j->...i", R, rhat)
             out["jacobi"] = kinetic - nu * m[..., 2] + 1.5 * nu**2 * _dot(r, _mv(inertia, r))
             return out
         if kinds == {SpaceTorque}:
-            tau = sum(per_body(tq.tau, 1) for tq in self.torques)
+            tau = sum(per_body(tq.tau, 1) for tq in cast(tuple[SpaceTorque, ...], self.torques))
             rest = m - t[:, None] * tau
             for i, ax in enumerate("xyz"):
                 out[f"m_{ax} - tau_{ax} t"] = rest[..., i]
         return out
 
 
-def as_model(body, torque=None) -> Model:
+def as_model(body: Model | RigidBody | ArrayLike, torque: TorqueLike = None) -> Model:
     """A :class:`Model` from ``body`` (a Model, a RigidBody or an inertia array) and ``torque``.
 
     Raises

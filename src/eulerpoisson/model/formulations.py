@@ -129,8 +129,8 @@ from __future__ import annotations
 import types
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from ..util.validate import as_float_array
 from ..attitude.core import (
     conversion_matrix,
     gibbs_from_quaternion,
@@ -143,9 +143,10 @@ from ..attitude.core import (
     quaternion_from_matrix,
     skew,
 )
-from .body import RigidBody
-from .torques import Gravity, GravityGradient, Torque, as_torques
 from ..errors import InvalidInputError, SingularChartError, UnsupportedModelError
+from ..util.validate import as_float_array
+from .body import RigidBody
+from .torques import Gravity, GravityGradient, Torque, TorqueLike, as_torques
 
 __all__ = [
     "Formulation",
@@ -545,7 +546,7 @@ def _potential_torques(body, torque, where: str) -> tuple:
     return torques
 
 
-def gibbs_potential_gradient(n, tau) -> np.ndarray:
+def gibbs_potential_gradient(n: ArrayLike, tau: ArrayLike) -> NDArray[np.float64]:
     r"""Gradient :math:`\partial U/\partial\mathbf n` of a potential from its body-frame torque.
 
     A potential :math:`U(R)` whose torque is :math:`\boldsymbol\tau`
@@ -595,7 +596,7 @@ def _add_block(out, sl, extra):
 # ---------------------------------------------------------------------------
 # Lagrangian side (batched numpy)
 # ---------------------------------------------------------------------------
-def metric_derivative(n, inertia) -> np.ndarray:
+def metric_derivative(n: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""Derivatives :math:`\partial_k G_{ij}` of the metric :math:`G = 4AIA^T`.
 
     With :math:`\partial_k A = [\mathbf e_k]_\times/s - 2n_kA/s` (:math:`s = 1+\mathbf n^2`),
@@ -640,7 +641,7 @@ def _metric_derivative(n, I):
     return s4 * (X + _T(X)) - s4 * n[..., :, None, None] * G[..., None, :, :]
 
 
-def christoffel(n, inertia) -> np.ndarray:
+def christoffel(n: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""Christoffel symbols :math:`\Gamma^i_{jk}(\mathbf n)` of :math:`G = 4AIA^T`, closed form.
 
     .. math::
@@ -698,7 +699,7 @@ def _christoffel(n, I, Iinv):
     return -(B + np.swapaxes(B, -1, -2)) - kin
 
 
-def christoffel_from_metric(n, inertia, dG=None) -> np.ndarray:
+def christoffel_from_metric(n: ArrayLike, inertia: ArrayLike, dG: ArrayLike | None = None) -> NDArray[np.float64]:
     r"""Christoffel symbols by the Levi-Civita formula (reference for :func:`christoffel`).
 
     .. math:: \Gamma^i_{jk} = \tfrac12 G^{il}\left(\partial_j G_{lk} + \partial_k G_{lj} - \partial_l G_{jk}\right)
@@ -729,7 +730,7 @@ def christoffel_from_metric(n, inertia, dG=None) -> np.ndarray:
     return np.einsum("...il,...ljk->...ijk", Ginv, first)
 
 
-def lagrangian(n, ndot, inertia) -> np.ndarray:
+def lagrangian(n: ArrayLike, ndot: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""The paper's Lagrangian :math:`L = \tfrac12 G_{ij}\dot n_i\dot n_j` (eq. 1.13).
 
     .. math:: L = \frac{2}{(1+\mathbf n^2)^2}\,(\dot{\mathbf n}-\mathbf n\times\dot{\mathbf n})^T I
@@ -755,7 +756,7 @@ def lagrangian(n, ndot, inertia) -> np.ndarray:
     return np.asarray(geodesic_energy(_cf(n), _cf(v), _cf2(body.inertia)))
 
 
-def canonical_momentum(n, ndot, inertia) -> np.ndarray:
+def canonical_momentum(n: ArrayLike, ndot: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r"""Canonical momentum :math:`\boldsymbol\pi = G\dot{\mathbf n} = 2AI\boldsymbol\Omega` (eq. 1.14, 1.26).
 
     Parameters
@@ -777,7 +778,7 @@ def canonical_momentum(n, ndot, inertia) -> np.ndarray:
     return _mvec(metric(n, body.inertia), v)
 
 
-def geodesic_acceleration(n, ndot, inertia) -> np.ndarray:
+def geodesic_acceleration(n: ArrayLike, ndot: ArrayLike, inertia: ArrayLike) -> NDArray[np.float64]:
     r""":math:`\ddot{\mathbf n} = -\Gamma(\dot{\mathbf n}, \dot{\mathbf n})` (see :func:`geodesic_rhs`).
 
     Parameters
@@ -862,6 +863,18 @@ class Formulation:
     angular velocity (..., 3). Formulations in :math:`\mathbf n` raise
     :class:`~eulerpoisson.errors.SingularChartError` for rotations by
     :math:`\pi`, where :math:`\mathbf n` is infinite.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> f = ep.formulation("canonical", [1.0, 2.0, 2.5])              # (n, pi), paper eq. 1.14-1.16
+    >>> type(f).__name__, f.name
+    ('Canonical', 'canonical')
+    >>> z = f.from_common([1.0, 0.0, 0.0, 0.0], [1.0, 0.1, 0.5])
+    >>> print(np.round(z, 6))
+    [0.  0.  0.  2.  0.4 2.5]
+    >>> print(np.round(f.vector_field(z), 6))
+    [ 0.5    0.05   0.25  -0.025  0.75  -0.1  ]
     """
 
     name: str = ""
@@ -873,7 +886,7 @@ class Formulation:
     rank: int = 0
     equations: dict = {}
 
-    def __init__(self, body, torque=None):
+    def __init__(self, body: RigidBody | ArrayLike, torque: TorqueLike = None) -> None:
         self.torques = _potential_torques(body, torque, f"the {self.name!r} formulation")
         self.body = _as_body(body)
         self._I = self.body.inertia
@@ -902,7 +915,7 @@ class Formulation:
 
     # -- the potential ------------------------------------------------------
     @staticmethod
-    def _time(t):
+    def _time(t: ArrayLike) -> np.ndarray:
         return as_float_array(t, "t")
 
     def _torque_at(self, t, R):
@@ -920,7 +933,7 @@ class Formulation:
             U = U + np.asarray(tq.potential(t, R, self._I), dtype=float)
         return U
 
-    def potential(self, state, t=0.0) -> np.ndarray:
+    def potential(self, state: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float64]:
         r"""Potential energy :math:`U(t, R)` of the torques, shape (...) (zero for the free body).
 
         Parameters
@@ -941,7 +954,7 @@ class Formulation:
             return np.zeros(shape)
         return np.broadcast_to(self._potential_at(t, self.matrix(x)), shape).copy()
 
-    def torque(self, state, t=0.0) -> np.ndarray:
+    def torque(self, state: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float64]:
         r"""Body-frame torque :math:`\boldsymbol\tau(t, R)` of the potential, shape (..., 3).
 
         Raises
@@ -985,7 +998,7 @@ class Formulation:
     def _batch(self, x):
         return np.broadcast_shapes(x.shape[:-1], self._bshape)
 
-    def unpack(self, state) -> dict:
+    def unpack(self, state: ArrayLike) -> dict[str, NDArray[np.float64]]:
         """Named blocks of ``state`` (views), e.g. ``{'n': (..., 3), 'pi': (..., 3)}``.
 
         Raises
@@ -998,7 +1011,7 @@ class Formulation:
             k: x[..., sl].reshape(x.shape[:-1] + self.block_shapes[k]) for k, sl in self.layout.items()
         }
 
-    def pack(self, **blocks) -> np.ndarray:
+    def pack(self, **blocks: ArrayLike) -> NDArray[np.float64]:
         """Assemble a state (..., d) from named blocks (broadcast against each other).
 
         Raises
@@ -1017,7 +1030,7 @@ class Formulation:
         return np.concatenate([np.broadcast_to(f, shape + f.shape[-1:]) for f in flat], -1)
 
     # -- dynamics -------------------------------------------------------------
-    def vector_field(self, state, t=0.0) -> np.ndarray:
+    def vector_field(self, state: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float64]:
         """Right-hand side :math:`\\dot z = P(z)\\nabla H(z, t)`, shape (..., d).
 
         ``t`` (float or array broadcast against the batch) matters only for a
@@ -1030,28 +1043,28 @@ class Formulation:
         """
         raise NotImplementedError
 
-    def rhs(self, t, y) -> np.ndarray:
+    def rhs(self, t: float, y: ArrayLike) -> NDArray[np.float64]:
         """``vector_field(y, t)`` with scipy's ``fun(t, y)`` signature."""
         return self.vector_field(y, t)
 
-    def hamiltonian(self, state, t=0.0) -> np.ndarray:
+    def hamiltonian(self, state: ArrayLike, t: ArrayLike = 0.0) -> NDArray[np.float64]:
         """Hamiltonian in these variables, :math:`H_0 + U(t, R)` (the kinetic energy plus the potential), shape (...)."""
         raise NotImplementedError
 
-    def poisson_tensor(self, state) -> np.ndarray:
+    def poisson_tensor(self, state: ArrayLike) -> NDArray[np.float64]:
         """Poisson tensor :math:`P_{ab} = \\{z_a, z_b\\}`, shape (..., d, d)."""
         raise NotImplementedError
 
-    def poisson_determinant(self, state) -> np.ndarray:
+    def poisson_determinant(self, state: ArrayLike) -> NDArray[np.float64]:
         """Closed-form :math:`\\det P(z)`, shape (...) (0 for a degenerate structure)."""
         raise NotImplementedError
 
-    def casimirs(self, state) -> np.ndarray:
+    def casimirs(self, state: ArrayLike) -> NDArray[np.float64]:
         """Casimir functions (..., k); ``k = 0`` for a nondegenerate structure."""
         x = self._check(state)
         return np.zeros(self._batch(x) + (0,))
 
-    def integrals(self, state, t=0.0) -> dict:
+    def integrals(self, state: ArrayLike, t: ArrayLike = 0.0) -> dict[str, NDArray[np.float64]]:
         r"""First integrals.
 
         Free body: ``H`` (...), ``m`` (..., 3), ``m2`` (...), ``m3`` (...).
@@ -1092,15 +1105,15 @@ class Formulation:
         return out
 
     # -- conversions --------------------------------------------------------
-    def to_common(self, state):
+    def to_common(self, state: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``(q, Omega)``: unit quaternions (..., 4) and body angular velocity (..., 3)."""
         raise NotImplementedError
 
-    def from_common(self, q, omega) -> np.ndarray:
+    def from_common(self, q: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
         """State (..., d) from unit quaternions (..., 4) and body angular velocities (..., 3)."""
         raise NotImplementedError
 
-    def convert(self, state, target) -> np.ndarray:
+    def convert(self, state: ArrayLike, target: str | Formulation) -> NDArray[np.float64]:
         """The same physical states in another formulation (a name or a :class:`Formulation`).
 
         The target uses this formulation's body unless a Formulation is given.
@@ -1116,27 +1129,27 @@ class Formulation:
             target = formulation(target, self.body)
         return target.from_common(*self.to_common(state))
 
-    def quaternion(self, state) -> np.ndarray:
+    def quaternion(self, state: ArrayLike) -> NDArray[np.float64]:
         """Unit quaternion (scalar first) of the attitude, (..., 4)."""
         return self.to_common(state)[0]
 
-    def matrix(self, state) -> np.ndarray:
+    def matrix(self, state: ArrayLike) -> NDArray[np.float64]:
         """Rotation matrix R (x_space = R x_body), (..., 3, 3)."""
         return matrix_from_quaternion(self.quaternion(state))
 
-    def gibbs(self, state) -> np.ndarray:
+    def gibbs(self, state: ArrayLike) -> NDArray[np.float64]:
         """The paper's Gibbs vector n, (..., 3). Raises SingularChartError at angle pi."""
         return gibbs_from_quaternion(self.quaternion(state))
 
-    def omega(self, state) -> np.ndarray:
+    def omega(self, state: ArrayLike) -> NDArray[np.float64]:
         r"""Body angular velocity :math:`\boldsymbol\Omega`, (..., 3)."""
         return self.to_common(state)[1]
 
-    def body_momentum(self, state) -> np.ndarray:
+    def body_momentum(self, state: ArrayLike) -> NDArray[np.float64]:
         r"""Body angular momentum :math:`\mathbf M = I\boldsymbol\Omega`, (..., 3)."""
         return _mvec(self._I, self.omega(state))
 
-    def spatial_momentum(self, state) -> np.ndarray:
+    def spatial_momentum(self, state: ArrayLike) -> NDArray[np.float64]:
         r"""Spatial angular momentum :math:`\mathbf m = RI\boldsymbol\Omega`, (..., 3)."""
         return _mvec(self.matrix(state), self.body_momentum(state))
 
@@ -1675,7 +1688,7 @@ _ALIASES = {
 }
 
 
-def formulation(name: str, body, torque=None) -> Formulation:
+def formulation(name: str, body: RigidBody | ArrayLike, torque: TorqueLike = None) -> Formulation:
     r"""Construct a formulation by registry name, for the free body or with a potential.
 
     Parameters

@@ -41,11 +41,12 @@ gradient). A. V. Borisov and I. S. Mamaev, *Rigid Body Dynamics*, De Gruyter
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeAlias
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidInputError
 from ..util.validate import as_float_array
@@ -103,6 +104,19 @@ class PolynomialTorque:
         :math:`\nu` (0: no orbit term).
     orbit_gain : ndarray, shape (...)
         :math:`\kappa` (:math:`3\nu^2` for the gravity gradient).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> p = ep.torques.Gravity(1.0, [0.0, 0.0, 0.1]).polynomial()   # tau = L (R^T s) for the gravity
+    >>> type(p).__name__, len(p.vectors)
+    ('PolynomialTorque', 1)
+    >>> print(p.vectors[0])
+    [ 0.    0.   -9.81]
+    >>> print(np.round(p.maps[0], 6) + 0.0)
+    [[ 0.  -0.1  0. ]
+     [ 0.1  0.   0. ]
+     [ 0.   0.   0. ]]
     """
 
     constant: np.ndarray
@@ -112,10 +126,10 @@ class PolynomialTorque:
     orbit_gain: np.ndarray = field(default_factory=lambda: np.zeros(()))
 
     @staticmethod
-    def zero() -> "PolynomialTorque":
+    def zero() -> PolynomialTorque:
         return PolynomialTorque(constant=np.zeros(3))
 
-    def __add__(self, other: "PolynomialTorque") -> "PolynomialTorque":
+    def __add__(self, other: PolynomialTorque) -> PolynomialTorque:
         og = np.broadcast_arrays(self.orbit_gain, other.orbit_gain)
         orate = np.broadcast_arrays(self.orbit_rate, other.orbit_rate)
         # one orbit per model: the rates of two orbit terms must agree where both act
@@ -135,7 +149,7 @@ class PolynomialTorque:
     def has_orbit(self) -> bool:
         return bool(np.any(self.orbit_gain != 0))
 
-    def flatten(self, batch_shape) -> "FlatPolynomialTorque":
+    def flatten(self, batch_shape: tuple[int, ...]) -> FlatPolynomialTorque:
         """The torque broadcast to ``batch_shape`` as flat per-body arrays (what the compiled kernels read)."""
         B = int(np.prod(batch_shape, dtype=int))
         tau0 = np.ascontiguousarray(np.broadcast_to(self.constant, batch_shape + (3,)).reshape(B, 3), dtype=float)
@@ -161,7 +175,7 @@ class FlatPolynomialTorque:
     nu: np.ndarray
     kappa: np.ndarray
 
-    def in_frame(self, P) -> "FlatPolynomialTorque":
+    def in_frame(self, P: NDArray[np.float64]) -> FlatPolynomialTorque:
         r"""The torque in a rotated body frame, :math:`\mathbf x' = P^T\mathbf x` (``P`` (B, 3, 3)).
 
         The body-frame parts turn (:math:`\boldsymbol\tau_0' = P^T\boldsymbol\tau_0`,
@@ -176,8 +190,8 @@ class FlatPolynomialTorque:
 class Torque:
     """Base class of torques; see the module docstring.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     kind : str
         Name used in files and the command line.
     conservative : bool
@@ -186,6 +200,20 @@ class Torque:
         The torque depends explicitly on time.
     depends_on_omega : bool
         The torque depends on the angular velocity (not a potential torque).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> class Drag(ep.torques.Torque):
+    ...     # tau = -c Omega: a damping (an example)
+    ...     kind, depends_on_omega = "drag", True
+    ...     def __init__(self, c):
+    ...         self.c = float(c)
+    ...     def evaluate(self, t, R, omega, inertia):
+    ...         return -self.c * omega
+    >>> tr = ep.solve([1.0, 2.0, 2.5], [0.0, 10.0], omega0=[0.0, 0.0, 1.0], torque=Drag(0.25), method="rk", tol=1e-10)
+    >>> print(np.round(tr.omega[-1], 6) + 0.0)                       # 2.5 Omega' = -0.25 Omega: exp(-1)
+    [0.       0.       0.367879]
     """
 
     kind: ClassVar[str] = ""
@@ -198,7 +226,7 @@ class Torque:
         """Batch shape of the parameters (``()`` for one set)."""
         return ()
 
-    def evaluate(self, t, R, omega, inertia) -> np.ndarray:
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         r"""Body-frame torque :math:`\boldsymbol\tau`.
 
         Parameters
@@ -218,7 +246,7 @@ class Torque:
         """
         raise NotImplementedError
 
-    def potential(self, t, R, inertia) -> np.ndarray:
+    def potential(self, t: ArrayLike, R: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         r"""Potential energy :math:`U(t, R)`, shape (...).
 
         Raises
@@ -236,7 +264,7 @@ class Torque:
         """A JSON-able record (``{"kind": ..., parameters...}``) read back by :func:`torque_from_dict`."""
         raise NotImplementedError(f"{type(self).__name__} cannot be written to a file")
 
-    def __getitem__(self, idx) -> "Torque":
+    def __getitem__(self, idx: Any) -> Torque:
         """The torque of one body (or a sub-batch) of a batch of parameters."""
         return self
 
@@ -306,12 +334,24 @@ class Gravity(Torque):
     References
     ----------
     Leimanis (1965), ch. I; Borisov and Mamaev (2018), §2.1.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> top = ep.torques.Gravity(mass=1.0, center_of_mass=[0.0, 0.0, 0.1])   # g = (0, 0, -9.81)
+    >>> top
+    Gravity(mass=1.0, center_of_mass=[0.0, 0.0, 0.1], g=[0.0, 0.0, -9.81])
+    >>> R = ep.Attitude.from_rotvec([np.pi / 2, 0.0, 0.0]).as_matrix()       # the axis horizontal
+    >>> print(np.round(top.evaluate(0.0, R, np.zeros(3), np.eye(3)), 12) + 0.0)   # body frame
+    [0.981 0.    0.   ]
+    >>> print(np.round(top.potential(0.0, np.eye(3), np.eye(3)), 12))        # U = -m g.(R c)
+    0.981
     """
 
     kind = "gravity"
     conservative = True
 
-    def __init__(self, mass, center_of_mass, g=(0.0, 0.0, -STANDARD_GRAVITY)):
+    def __init__(self, mass: ArrayLike, center_of_mass: ArrayLike, g: ArrayLike = (0.0, 0.0, -STANDARD_GRAVITY)) -> None:
         self.mass = _scalar_array(mass, "mass", "Gravity", positive=True)
         self.center_of_mass = _vec(center_of_mass, "center_of_mass", "Gravity")
         self.g = _vec(g, "g", "Gravity")
@@ -319,7 +359,7 @@ class Gravity(Torque):
                              g=self.g[..., 0])
 
     @property
-    def batch_shape(self):
+    def batch_shape(self) -> tuple[int, ...]:
         return self._shape
 
     @property
@@ -327,13 +367,13 @@ class Gravity(Torque):
         r""":math:`\mu\mathbf c`, shape (..., 3)."""
         return self.mass[..., None] * self.center_of_mass
 
-    def evaluate(self, t, R, omega, inertia):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.cross(self.moment_arm, _bT(R, self.g))
 
-    def potential(self, t, R, inertia):
+    def potential(self, t: ArrayLike, R: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         return -np.einsum("...i,...i->...", self.g, np.einsum("...ij,...j->...i", R, self.moment_arm))
 
-    def polynomial(self):
+    def polynomial(self) -> PolynomialTorque:
         mc = self.moment_arm
         L = np.zeros(mc.shape[:-1] + (3, 3))
         L[..., 0, 1], L[..., 0, 2] = -mc[..., 2], mc[..., 1]
@@ -341,16 +381,16 @@ class Gravity(Torque):
         L[..., 2, 0], L[..., 2, 1] = -mc[..., 1], mc[..., 0]
         return PolynomialTorque(constant=np.zeros(3), vectors=(self.g,), maps=(L,))
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "mass": _plain(self.mass), "center_of_mass": _plain(self.center_of_mass),
                 "g": _plain(self.g)}
 
-    def __getitem__(self, idx):
+    def __getitem__(self, idx: Any) -> Gravity:
         b = self._shape
         return Gravity(np.broadcast_to(self.mass, b)[idx], np.broadcast_to(self.center_of_mass, b + (3,))[idx],
                        np.broadcast_to(self.g, b + (3,))[idx])
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"Gravity(mass={_plain(self.mass)!r}, center_of_mass={_plain(self.center_of_mass)!r}, g={_plain(self.g)!r})"
 
 
@@ -380,45 +420,55 @@ class GravityGradient(Torque):
     ----------
     P. C. Hughes, *Spacecraft Attitude Dynamics* (1986), §8.3; V. V. Beletsky,
     *Motion of an Artificial Satellite about its Center of Mass* (1966), ch. 1.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> gg = ep.torques.GravityGradient(mean_motion=0.1)
+    >>> print(gg.direction(0.0), gg.conservative, gg.time_dependent)
+    [1. 0. 0.] True True
+    >>> R = ep.Attitude.from_rotvec([0.0, 0.0, 0.3]).as_matrix()
+    >>> print(np.round(gg.evaluate(0.0, R, np.zeros(3), np.diag([1.0, 2.0, 2.5])), 9) + 0.0)
+    [ 0.          0.         -0.00846964]
     """
 
     kind = "gravity_gradient"
     conservative = True
     time_dependent = True
 
-    def __init__(self, mean_motion):
+    def __init__(self, mean_motion: ArrayLike) -> None:
         self.mean_motion = _scalar_array(mean_motion, "mean_motion", "GravityGradient", nonnegative=True)
 
     @property
-    def batch_shape(self):
+    def batch_shape(self) -> tuple[int, ...]:
         return self.mean_motion.shape
 
-    def direction(self, t) -> np.ndarray:
+    def direction(self, t: ArrayLike) -> NDArray[np.float64]:
         r""":math:`\hat{\mathbf r}(t)` in the space frame, shape (..., 3)."""
         phase = np.asarray(t, dtype=float) * self.mean_motion
         return np.stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)], -1)
 
-    def evaluate(self, t, R, omega, inertia):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         r = _bT(R, self.direction(t))
         Ir = np.einsum("...ij,...j->...i", inertia, r)
         return 3.0 * (self.mean_motion**2)[..., None] * np.cross(r, Ir)
 
-    def potential(self, t, R, inertia):
+    def potential(self, t: ArrayLike, R: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         r = _bT(R, self.direction(t))
         Ir = np.einsum("...ij,...j->...i", inertia, r)
         return 1.5 * self.mean_motion**2 * np.einsum("...i,...i->...", r, Ir)
 
-    def polynomial(self):
+    def polynomial(self) -> PolynomialTorque:
         return PolynomialTorque(constant=np.zeros(3), orbit_rate=self.mean_motion,
                                 orbit_gain=3.0 * self.mean_motion**2)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "mean_motion": _plain(self.mean_motion)}
 
-    def __getitem__(self, idx):
+    def __getitem__(self, idx: Any) -> GravityGradient:
         return GravityGradient(np.broadcast_to(self.mean_motion, self.batch_shape)[idx])
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"GravityGradient(mean_motion={_plain(self.mean_motion)!r})"
 
 
@@ -429,30 +479,38 @@ class BodyTorque(Torque):
     ----------
     tau : array_like, shape (..., 3)
         Body frame.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> kick = ep.torques.BodyTorque([0.0, 0.0, 0.5])
+    >>> tr = ep.solve([1.0, 2.0, 2.5], [0.0, 2.0], omega0=[0.0, 0.0, 0.0], torque=kick, method="taylor")
+    >>> print(np.round(tr.omega[-1], 12) + 0.0)                      # about a principal axis: 2.5 Omega' = 0.5
+    [0.  0.  0.4]
     """
 
     kind = "body_torque"
 
-    def __init__(self, tau):
+    def __init__(self, tau: ArrayLike) -> None:
         self.tau = _vec(tau, "tau", "BodyTorque")
 
     @property
-    def batch_shape(self):
+    def batch_shape(self) -> tuple[int, ...]:
         return self.tau.shape[:-1]
 
-    def evaluate(self, t, R, omega, inertia):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.broadcast_to(self.tau, np.broadcast_shapes(self.tau.shape, np.shape(omega))).copy()
 
-    def polynomial(self):
+    def polynomial(self) -> PolynomialTorque:
         return PolynomialTorque(constant=self.tau)
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "tau": _plain(self.tau)}
 
-    def __getitem__(self, idx):
+    def __getitem__(self, idx: Any) -> BodyTorque:
         return BodyTorque(self.tau[idx]) if self.tau.ndim > 1 else self
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"BodyTorque(tau={_plain(self.tau)!r})"
 
 
@@ -463,31 +521,39 @@ class SpaceTorque(Torque):
     ----------
     tau : array_like, shape (..., 3)
         Space frame.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> push = ep.torques.SpaceTorque([0.1, 0.0, 0.0])
+    >>> tr = ep.solve([1.0, 2.0, 2.5], [0.0, 3.0], omega0=[0.0, 0.2, 0.0], torque=push, method="taylor")
+    >>> print(np.round(tr.m[-1] - tr.m[0], 12) + 0.0)                # m grows by tau_s t
+    [0.3 0.  0. ]
     """
 
     kind = "space_torque"
 
-    def __init__(self, tau):
+    def __init__(self, tau: ArrayLike) -> None:
         self.tau = _vec(tau, "tau", "SpaceTorque")
 
     @property
-    def batch_shape(self):
+    def batch_shape(self) -> tuple[int, ...]:
         return self.tau.shape[:-1]
 
-    def evaluate(self, t, R, omega, inertia):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         return _bT(R, self.tau)
 
-    def polynomial(self):
+    def polynomial(self) -> PolynomialTorque:
         eye = np.broadcast_to(np.eye(3), self.tau.shape[:-1] + (3, 3))
         return PolynomialTorque(constant=np.zeros(3), vectors=(self.tau,), maps=(eye,))
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "tau": _plain(self.tau)}
 
-    def __getitem__(self, idx):
+    def __getitem__(self, idx: Any) -> SpaceTorque:
         return SpaceTorque(self.tau[idx]) if self.tau.ndim > 1 else self
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"SpaceTorque(tau={_plain(self.tau)!r})"
 
 
@@ -510,18 +576,29 @@ class CallableTorque(Torque):
     ------
     TypeError
         ``func`` is not callable.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> def damping(t, q, omega):
+    ...     return -0.1 * omega
+    >>> tq = ep.torques.CallableTorque(damping)
+    >>> tq, tq.kind
+    (CallableTorque('damping'), 'callable')
+    >>> print(tq.evaluate(0.0, np.eye(3), np.array([1.0, 2.0, 3.0]), np.eye(3)))
+    [-0.1 -0.2 -0.3]
     """
 
     kind = "callable"
     depends_on_omega = True  # unknown: assume the worst
     time_dependent = True
 
-    def __init__(self, func: Callable):
+    def __init__(self, func: Callable[..., ArrayLike]) -> None:
         if not callable(func):
             raise TypeError(f"torque must be a Torque or a callable torque(t, q, omega), got {func!r}")
         self.func = func
 
-    def evaluate(self, t, R, omega, inertia, q=None):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64], q: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
         if q is None:
             from ..attitude.core import quaternion_from_rotation_matrix
 
@@ -540,10 +617,10 @@ class CallableTorque(Torque):
                     f"(the shape of omega: one body-frame torque per body)"
                 ) from None
         if not np.all(np.isfinite(tau)):
-            raise InvalidInputError(f"the torque function {self.func!r} returned NaN or infinite values at t = {t}")
+            raise InvalidInputError(f"the torque function {self.func!r} returned NaN or infinite values at t = {t!s}")
         return tau
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"CallableTorque({getattr(self.func, '__name__', self.func)!r})"
 
 
@@ -552,22 +629,34 @@ class UnrecordedTorque(Torque):
 
     The trajectory's data is intact; anything that must evaluate the torque
     raises :class:`NotImplementedError` naming it.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> tq = ep.torques.UnrecordedTorque("CallableTorque('damping')")   # as read back from a file
+    >>> tq, tq.to_dict()
+    (UnrecordedTorque("CallableTorque('damping')"), {'kind': 'unrecorded', 'description': "CallableTorque('damping')"})
+    >>> try:
+    ...     tq.evaluate(0.0, np.eye(3), np.zeros(3), np.eye(3))
+    ... except NotImplementedError as err:
+    ...     print(err)
+    the torque CallableTorque('damping') was a Python function and was not saved in the file
     """
 
     kind = "unrecorded"
     depends_on_omega = True
     time_dependent = True
 
-    def __init__(self, description: str = ""):
+    def __init__(self, description: str = "") -> None:
         self.description = description
 
-    def evaluate(self, t, R, omega, inertia):
+    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
         raise NotImplementedError(f"the torque {self.description} was a Python function and was not saved in the file")
 
-    def to_dict(self):
+    def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "description": self.description}
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"UnrecordedTorque({self.description!r})"
 
 
@@ -581,6 +670,15 @@ def torque_from_dict(d: dict) -> Torque:
     ------
     InvalidInputError
         Unknown kind or missing/unknown parameters.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> rec = ep.torques.Gravity(2.0, [0.0, 0.0, 0.1]).to_dict()
+    >>> rec
+    {'kind': 'gravity', 'mass': 2.0, 'center_of_mass': [0.0, 0.0, 0.1], 'g': [0.0, 0.0, -9.81]}
+    >>> ep.torques.torque_from_dict(rec)
+    Gravity(mass=2.0, center_of_mass=[0.0, 0.0, 0.1], g=[0.0, 0.0, -9.81])
     """
     if not isinstance(d, dict) or "kind" not in d:
         raise InvalidInputError(f"a torque record must be a dict with a 'kind', got {d!r}")
@@ -594,20 +692,33 @@ def torque_from_dict(d: dict) -> Torque:
         raise InvalidInputError(f"torque {kind!r}: {exc}") from None
 
 
-def as_torques(torque) -> tuple[Torque, ...]:
+#: what ``torque=`` accepts: a :class:`Torque`, a callable ``torque(t, q, omega) -> tau_body``, a list of
+#: them, or None (the free body)
+TorqueLike: TypeAlias = "Torque | Callable[..., ArrayLike] | Sequence[Torque | Callable[..., ArrayLike]] | None"
+
+
+def as_torques(torque: TorqueLike) -> tuple[Torque, ...]:
     """Normalize ``torque=`` (None, a Torque, a callable, or a list of them) to a tuple of :class:`Torque`.
 
     Raises
     ------
     TypeError
         An entry that is neither a :class:`Torque` nor callable.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> ep.torques.as_torques(None)
+    ()
+    >>> ep.torques.as_torques([ep.torques.BodyTorque([0.0, 0.0, 1.0]), lambda t, q, omega: 0.0 * omega])
+    (BodyTorque(tau=[0.0, 0.0, 1.0]), CallableTorque('<lambda>'))
     """
     if torque is None:
         return ()
     if isinstance(torque, Torque):
         return (torque,)
     if isinstance(torque, (list, tuple)):
-        out = []
+        out: list[Torque] = []
         for item in torque:
             out.extend(as_torques(item))
         return tuple(out)

@@ -249,6 +249,17 @@ class JacobiParams:
     """
 
     __slots__ = ("m", "m1", "kp", "sep", "imag", "kh", "kl", "sqm", "pcl", "ph", "pcorr")
+    m: np.ndarray
+    m1: np.ndarray
+    kp: np.ndarray
+    sep: np.ndarray
+    imag: np.ndarray
+    kh: np.ndarray
+    kl: np.ndarray
+    sqm: np.ndarray
+    pcl: np.ndarray
+    ph: np.ndarray
+    pcorr: np.ndarray
 
     def take(self, index):
         """Gather along the (flattened, 1-d) parameter axis."""

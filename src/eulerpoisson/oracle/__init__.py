@@ -13,11 +13,22 @@ from __future__ import annotations
 
 import os
 
+from numpy.typing import ArrayLike
+
 from .cases import CASE_NAMES, ReferenceCase, reference_case, reference_cases, write_cases
 from .compare import ValidationReport, compare_run
 from .plot import plot_report
-from .runs import (ATTITUDE_CONVENTIONS, NORM_TOLERANCE, OMEGA_FRAMES, QUATERNION_ORDERS, Conventions, RawRun,
-                   normalize_run, read_run, run_from_arrays)
+from .runs import (
+    ATTITUDE_CONVENTIONS,
+    NORM_TOLERANCE,
+    OMEGA_FRAMES,
+    QUATERNION_ORDERS,
+    Conventions,
+    RawRun,
+    normalize_run,
+    read_run,
+    run_from_arrays,
+)
 
 __all__ = [
     "validate", "ValidationReport", "compare_run", "Conventions", "RawRun", "read_run", "run_from_arrays",
@@ -26,8 +37,8 @@ __all__ = [
 ]
 
 
-def validate(run, inertia=None, *, quaternion_order=None, omega_frame="body", attitude_convention="body-to-space",
-             tolerance=None, detect=True) -> ValidationReport:
+def validate(run: str | os.PathLike[str] | RawRun, inertia: ArrayLike | None = None, *, quaternion_order: str | None = None, omega_frame: str = "body", attitude_convention: str = "body-to-space",
+             tolerance: float | None = None, detect: bool = True) -> ValidationReport:
     """Validate a run (a file or a :class:`RawRun`) against the exact free motion from its first sample.
 
     Parameters

@@ -20,13 +20,19 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import InvalidInputError
 from .runs import CSV_HEADER
+
+if TYPE_CHECKING:
+    from ..trajectory import Trajectory
 
 __all__ = ["ReferenceCase", "reference_cases", "reference_case", "write_cases", "CASE_NAMES"]
 
@@ -54,6 +60,15 @@ class ReferenceCase:
     -----
     :attr:`t`, :attr:`quaternion` and :attr:`omega` (shapes (T,), (T, 4),
     (T, 3)) are computed on first access.
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import reference_case
+    >>> case = reference_case("symmetric_top")
+    >>> type(case).__name__, case.inertia, case.samples
+    ('ReferenceCase', (1.0, 1.0, 1.5), 3001)
+    >>> case.t.shape, case.quaternion.shape
+    ((3001,), (3001, 4))
     """
 
     name: str
@@ -66,12 +81,12 @@ class ReferenceCase:
     flips: bool = False
 
     @property
-    def inertia_array(self) -> np.ndarray:
+    def inertia_array(self) -> NDArray[np.float64]:
         """The inertia as an array, shape (3,) or (3, 3)."""
         return np.array(self.inertia, dtype=float)
 
     @cached_property
-    def trajectory(self):
+    def trajectory(self) -> Trajectory:
         """The exact motion (a :class:`~eulerpoisson.Trajectory`)."""
         from ..solvers import solve
 
@@ -79,17 +94,17 @@ class ReferenceCase:
         return solve(self.inertia_array, t, omega0=self.omega0, attitude0=self.quaternion0, method="exact")
 
     @property
-    def t(self) -> np.ndarray:
+    def t(self) -> NDArray[np.float64]:
         """Output times, shape (T,)."""
         return self.trajectory.t
 
     @property
-    def quaternion(self) -> np.ndarray:
+    def quaternion(self) -> NDArray[np.float64]:
         """Attitudes (w, x, y, z), body to space, shape (T, 4)."""
         return self.trajectory.quaternion
 
     @property
-    def omega(self) -> np.ndarray:
+    def omega(self) -> NDArray[np.float64]:
         """Body angular velocities, shape (T, 3)."""
         return self.trajectory.omega
 
@@ -104,7 +119,7 @@ class ReferenceCase:
                 "quaternion0": list(map(float, self.quaternion0)), "t_end": float(self.t_end),
                 "samples": int(self.samples), "flips": self.flips}
 
-    def to_csv(self, path) -> None:
+    def to_csv(self, path: str | os.PathLike[str]) -> None:
         """Write ``t,qw,qx,qy,qz,wx,wy,wz`` with 17 significant digits (round-trips float64)."""
         from ..io.atomic import atomic_path
 
@@ -112,7 +127,7 @@ class ReferenceCase:
         with atomic_path(path) as tmp:
             np.savetxt(tmp, data, delimiter=",", header=",".join(CSV_HEADER), comments="", fmt="%.17g")
 
-    def to_netcdf(self, path) -> None:
+    def to_netcdf(self, path: str | os.PathLike[str]) -> None:
         """Write the exact trajectory as an eulerpoisson NetCDF file (needs the ``io`` extra)."""
         self.trajectory.to_netcdf(path)
 
@@ -179,6 +194,17 @@ def reference_case(name: str) -> ReferenceCase:
     ------
     InvalidInputError
         An unknown name (the message lists the names).
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import reference_case
+    >>> reference_case("sphere").description
+    'a spherical body: Omega constant, a uniform rotation'
+    >>> try:
+    ...     reference_case("cube")
+    ... except ValueError as err:
+    ...     print(err)
+    unknown reference case 'cube'; cases: tennis_racket_circulating_1, ...
     """
     cases = reference_cases()
     if name not in cases:
@@ -219,7 +245,7 @@ def _readme(cases, netcdf: bool) -> str:
     return "\n".join(lines)
 
 
-def write_cases(out, names=None, *, netcdf: bool = True) -> list[str]:
+def write_cases(out: str | os.PathLike[str], names: Sequence[str] | None = None, *, netcdf: bool = True) -> list[str]:
     """Write the suite into a folder: ``NAME.csv``, ``NAME.nc``, ``cases.json`` and ``README.md``.
 
     Parameters
@@ -240,6 +266,14 @@ def write_cases(out, names=None, *, netcdf: bool = True) -> list[str]:
     ------
     InvalidInputError
         An unknown case name; ``out`` is an existing file.
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import write_cases
+    >>> import os
+    >>> files = write_cases("cases", ["sphere"], netcdf=False)
+    >>> sorted(os.path.basename(f) for f in files)
+    ['README.md', 'cases.json', 'sphere.csv']
     """
     out = os.fspath(out)
     if os.path.exists(out) and not os.path.isdir(out):

@@ -24,8 +24,10 @@ L. D. Landau and E. M. Lifshitz, *Mechanics*, §37 (the free asymmetric top).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
 from .runs import QUATERNION_ORDERS, Conventions, RawRun, all_conventions, normalize_run
@@ -42,6 +44,9 @@ NEAR_INTERMEDIATE = 0.9
 _DETECT_SAMPLES = 20000
 #: most flips of a run that are located
 _MAX_FLIPS = 100_000
+
+#: the default of ValidationReport's series (typed Any: compare_run always gives arrays)
+_NOT_GIVEN: Any = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -88,6 +93,17 @@ class ValidationReport:
     warnings : tuple of str
     t, attitude_error, omega_error, energy_error, momentum_error : ndarray, shape (T,)
         The series (not in :meth:`to_dict`).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.oracle import run_from_arrays, validate
+    >>> tr = ep.solve([1.0, 2.0, 2.5], np.linspace(0.0, 10.0, 101), omega0=[1.0, 0.1, 0.5], method="rk", tol=1e-8)
+    >>> rep = validate(run_from_arrays(tr.t, tr.quaternion, tr.omega), [1.0, 2.0, 2.5], tolerance=1e-5)
+    >>> rep.verdict, rep.samples, bool(rep.max_attitude_error < 1e-5)
+    ('pass', 101, True)
+    >>> sorted(rep.to_dict())[:5]
+    ['convention_hint', 'conventions', 'energy_drift', 'exceeded_at', 'flip_time_errors']
     """
 
     source: str
@@ -111,11 +127,12 @@ class ValidationReport:
     convention_hint: str | None = None
     suggested_conventions: Conventions | None = None
     warnings: tuple = ()
-    t: np.ndarray = field(default=None, repr=False)
-    attitude_error: np.ndarray = field(default=None, repr=False)
-    omega_error: np.ndarray = field(default=None, repr=False)
-    energy_error: np.ndarray = field(default=None, repr=False)
-    momentum_error: np.ndarray = field(default=None, repr=False)
+    # the series: compare_run always gives them (the default is None)
+    t: np.ndarray = field(default=_NOT_GIVEN, repr=False)
+    attitude_error: np.ndarray = field(default=_NOT_GIVEN, repr=False)
+    omega_error: np.ndarray = field(default=_NOT_GIVEN, repr=False)
+    energy_error: np.ndarray = field(default=_NOT_GIVEN, repr=False)
+    momentum_error: np.ndarray = field(default=_NOT_GIVEN, repr=False)
 
     @property
     def passed(self) -> bool:
@@ -371,7 +388,7 @@ def _detect(raw: RawRun, body, stated: Conventions, att: np.ndarray):
     end = max(min(end, n), k + 1)
     sub = raw.head(end)
     so = stated.quaternion_order or raw.label_order
-    best, best_err = None, None
+    best, best_err = None, float("inf")
     for conv in all_conventions(raw):
         if (conv.quaternion_order, conv.omega_frame, conv.attitude_convention) == (so, stated.omega_frame,
                                                                                   stated.attitude_convention):
@@ -388,7 +405,7 @@ def _detect(raw: RawRun, body, stated: Conventions, att: np.ndarray):
     return best
 
 
-def compare_run(raw: RawRun, inertia=None, *, conventions: Conventions | None = None, tolerance=None,
+def compare_run(raw: RawRun, inertia: ArrayLike | None = None, *, conventions: Conventions | None = None, tolerance: float | None = None,
                 detect: bool = True) -> ValidationReport:
     """Validate a run against the exact free motion from its first sample.
 
@@ -414,6 +431,17 @@ def compare_run(raw: RawRun, inertia=None, *, conventions: Conventions | None = 
     InvalidInputError
         No inertia, a bad inertia (:class:`~eulerpoisson.InvalidInertiaError`),
         quaternions far from unit norm, a tolerance that is not a positive number.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.oracle import Conventions, compare_run, run_from_arrays
+    >>> tr = ep.solve([1.0, 2.0, 2.5], np.linspace(0.0, 10.0, 101), omega0=[1.0, 0.1, 0.5])
+    >>> xyzw = tr.quaternion[:, [1, 2, 3, 0]]                          # a run written scalar last
+    >>> raw = run_from_arrays(tr.t, xyzw, tr.omega, quaternion_order="xyzw")
+    >>> rep = compare_run(raw, [1.0, 2.0, 2.5], conventions=Conventions(quaternion_order="xyzw"), tolerance=1e-9)
+    >>> rep.verdict
+    'pass'
     """
     from ..model.body import RigidBody
 

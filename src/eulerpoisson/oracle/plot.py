@@ -2,7 +2,15 @@
 
 from __future__ import annotations
 
+import os
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from .compare import ValidationReport
 
 __all__ = ["plot_report"]
 
@@ -10,7 +18,7 @@ __all__ = ["plot_report"]
 FLOOR = 1e-17
 
 
-def plot_report(report, out=None, *, title: str | None = None):
+def plot_report(report: ValidationReport | list[tuple[str, ValidationReport]] | tuple[tuple[str, ValidationReport], ...], out: str | os.PathLike[str] | None = None, *, title: str | None = None) -> Figure:
     """Draw a :class:`~eulerpoisson.oracle.ValidationReport`.
 
     Parameters
@@ -31,6 +39,17 @@ def plot_report(report, out=None, *, title: str | None = None):
     ------
     MissingDependencyError
         Without matplotlib (extra ``plot``).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.oracle import plot_report, run_from_arrays, validate
+    >>> tr = ep.solve([1.0, 2.0, 2.5], np.linspace(0.0, 5.0, 51), omega0=[1.0, 0.1, 0.5])
+    >>> rep = validate(run_from_arrays(tr.t, tr.quaternion, tr.omega), [1.0, 2.0, 2.5])
+    >>> fig = plot_report(rep, "report.png", title="exact vs exact")
+    >>> import os
+    >>> os.path.exists("report.png"), len(fig.axes) > 0
+    (True, True)
     """
     from ..errors import require
     from ..viz.plots import plain_text  # text, never mathtext
@@ -39,7 +58,7 @@ def plot_report(report, out=None, *, title: str | None = None):
     from matplotlib import rcParams
     from matplotlib.figure import Figure  # no pyplot: no window, no global backend change
 
-    items = [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
+    items: list[tuple[str, ValidationReport]] = [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
     fig = Figure(figsize=(8, 6.5), layout="constrained")
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     colors = rcParams["axes.prop_cycle"].by_key()["color"]

@@ -31,8 +31,10 @@ import itertools
 import json
 import os
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 from ..attitude.core import matrix_from_unit_quaternion
 from ..errors import InvalidInputError
@@ -90,6 +92,17 @@ class Conventions:
     ------
     InvalidInputError
         A value outside the lists above.
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import Conventions
+    >>> Conventions(quaternion_order="xyzw", omega_frame="space")
+    Conventions(quaternion_order='xyzw', omega_frame='space', attitude_convention='body-to-space')
+    >>> try:
+    ...     Conventions(omega_frame="inertial")
+    ... except ValueError as err:
+    ...     print(err)
+    omega_frame must be one of 'body', 'space', got 'inertial'
     """
 
     quaternion_order: str | None = None
@@ -130,6 +143,14 @@ class RawRun:
         The inertia the file states (an eulerpoisson NetCDF file), else None.
     quaternion_columns : tuple of str
         The names of the quaternion columns.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.oracle import run_from_arrays
+    >>> raw = run_from_arrays([0.0, 1.0], [[1.0, 0.0, 0.0, 0.0], [0.9, 0.1, 0.0, 0.0]], [[0.2, 0.0, 0.0]] * 2)
+    >>> type(raw).__name__, raw.t.shape, raw.quaternion.shape, raw.label_order, raw.source
+    ('RawRun', (2,), (2, 4), 'wxyz', 'arrays')
     """
 
     t: np.ndarray
@@ -143,7 +164,7 @@ class RawRun:
     def __len__(self) -> int:
         return self.t.shape[0]
 
-    def head(self, n: int) -> "RawRun":
+    def head(self, n: int) -> RawRun:
         """The first ``n`` samples."""
         return replace(self, t=self.t[:n], quaternion=self.quaternion[:n], omega=self.omega[:n])
 
@@ -173,7 +194,7 @@ def _check_arrays(t, q, w, source: str) -> tuple[np.ndarray, np.ndarray, np.ndar
     return t, q, w
 
 
-def run_from_arrays(t, quaternion, omega, *, quaternion_order: str = "wxyz", source: str = "arrays") -> RawRun:
+def run_from_arrays(t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, *, quaternion_order: str = "wxyz", source: str = "arrays") -> RawRun:
     """A :class:`RawRun` from arrays.
 
     Parameters
@@ -197,6 +218,18 @@ def run_from_arrays(t, quaternion, omega, *, quaternion_order: str = "wxyz", sou
     ------
     InvalidInputError
         Wrong shapes, fewer than 2 samples, NaN or inf, times that do not increase strictly.
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import run_from_arrays
+    >>> raw = run_from_arrays([0.0, 1.0], [[0.0, 0.0, 0.0, 1.0]] * 2, [[0.0, 0.0, 0.0]] * 2, quaternion_order="xyzw")
+    >>> raw.quaternion[0], raw.label_order
+    (array([0., 0., 0., 1.]), 'xyzw')
+    >>> try:
+    ...     run_from_arrays([1.0, 0.0], [[1.0, 0.0, 0.0, 0.0]] * 2, [[0.0, 0.0, 0.0]] * 2)
+    ... except ValueError as err:
+    ...     print(err)
+    arrays: times must increase strictly; sample 1 has t = 0.0 after t = 1.0 (sort the run, or drop repeated samples)
     """
     if quaternion_order not in QUATERNION_ORDERS:
         raise InvalidInputError(f"quaternion_order must be one of {', '.join(QUATERNION_ORDERS)}, got {quaternion_order!r}")
@@ -230,7 +263,7 @@ def _columns(names: list[str], source: str) -> tuple[int, list[int], str, list[i
     if missing:
         raise InvalidInputError(f"{source}: missing column(s) {', '.join(missing)} (expected a header like "
                                 f"{','.join(CSV_HEADER)}; got {','.join(names)})")
-    return it, qi, order, wi
+    return cast(int, it), qi, order, cast("list[int]", wi)  # none missing: all found
 
 
 def _read_csv(path: str) -> RawRun:
@@ -274,12 +307,12 @@ def _read_json(path: str) -> RawRun:
     if "quaternion" in keys and "omega" in keys and any(k in keys for k in _TIME_NAMES):
         tk = next(k for k in keys if k in _TIME_NAMES)
         try:
-            t = [r[tk] for r in recs]
-            q = [r["quaternion"] for r in recs]
-            w = [r["omega"] for r in recs]
+            tl = [r[tk] for r in recs]
+            ql = [r["quaternion"] for r in recs]
+            wl = [r["omega"] for r in recs]
         except KeyError as exc:
             raise InvalidInputError(f"{path}: a record has no key {exc.args[0]!r}") from None
-        t, q, w = _check_arrays(t, q, w, path)
+        t, q, w = _check_arrays(tl, ql, wl, path)
         return RawRun(t, q, w, label_order="wxyz", source=path, quaternion_columns=("quaternion",) * 4)
     it, qi, order, wi = _columns(keys, path)
     try:
@@ -304,7 +337,7 @@ def _read_netcdf(path: str) -> RawRun:
     return RawRun(t, q, w, label_order="wxyz", source=path, inertia=np.array(tr.body.inertia))
 
 
-def read_run(path) -> RawRun:
+def read_run(path: str | os.PathLike[str]) -> RawRun:
     """Read a run: a CSV file, an eulerpoisson NetCDF trajectory or a JSON list of records.
 
     Parameters
@@ -327,6 +360,17 @@ def read_run(path) -> RawRun:
         No such file, an unknown extension, missing columns, a value that is
         not a number, fewer than 2 samples, non-finite values, times that do
         not increase strictly.
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle import read_run
+    >>> with open("run.csv", "w") as fh:
+    ...     print("t,qw,qx,qy,qz,wx,wy,wz", file=fh)
+    ...     print("0.0,1.0,0.0,0.0,0.0,0.0,0.0,1.0", file=fh)
+    ...     print("1.0,0.8775825619,0.0,0.0,0.4794255386,0.0,0.0,1.0", file=fh)
+    >>> raw = read_run("run.csv")
+    >>> print(raw.t, raw.quaternion_columns, raw.omega[-1])
+    [0. 1.] ('qw', 'qx', 'qy', 'qz') [0. 0. 1.]
     """
     path = os.fspath(path)
     if not os.path.exists(path):
@@ -348,7 +392,7 @@ def _permutation(order: str) -> list[int]:
     return [order.index(c) for c in "wxyz"]
 
 
-def normalize_run(raw: RawRun, conventions: Conventions | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def normalize_run(raw: RawRun, conventions: Conventions | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     r"""The run in eulerpoisson's conventions.
 
     Parameters
@@ -371,6 +415,15 @@ def normalize_run(raw: RawRun, conventions: Conventions | None = None) -> tuple[
     ------
     InvalidInputError
         A quaternion whose norm differs from 1 by more than :data:`NORM_TOLERANCE`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.oracle import Conventions, normalize_run, run_from_arrays
+    >>> raw = run_from_arrays([0.0, 1.0], [[0.0, 0.0, 0.0, 1.0]] * 2, [[0.0, 0.0, 0.5]] * 2, quaternion_order="xyzw")
+    >>> t, q, w = normalize_run(raw, Conventions(quaternion_order="xyzw"))
+    >>> print(q[0], w[0])                                              # scalar first, body rates
+    [1. 0. 0. 0.] [0.  0.  0.5]
     """
     conv = conventions or Conventions()
     order = conv.quaternion_order or raw.label_order

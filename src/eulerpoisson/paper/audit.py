@@ -24,22 +24,30 @@ Frames
 The transcriptions are evaluated in a *frame* that fixes the variables and
 the meaning of names such as ``m`` or ``Omega``:
 
-``plain``        :math:`\mathbf n` only.
-``velocity``     :math:`(\mathbf n, \dot{\mathbf n})`; ``Omega``, ``omega``
-                 from :math:`R^T\dot R`, :math:`\dot RR^T`; ``EL``,
-                 ``Gamma2``, ``ddt``, ``on_shell`` for the geodesic footnote.
-``canonical``    :math:`(\mathbf n, \boldsymbol\pi)`; ``H``, ``m``,
-                 ``Omega``, ``M``, ``ndot``, ``Omegadot`` derived; ``PB``.
-``nm``, ``nOmega``, ``nM``  the non-canonical charts; ``pi`` is
-                 :math:`\boldsymbol\pi(\mathbf n, X)`, ``PBnX``, ``PBXX``, ``P``
-                 the brackets and Poisson tensor.
-``phase-velocity``  :math:`(\mathbf n,\boldsymbol\pi,\dot{\mathbf n},\dot{\boldsymbol\pi})`.
-``kinematic``    :math:`(\mathbf n, \boldsymbol\Omega)` with
-                 :math:`\dot{\mathbf n}` solving :math:`\boldsymbol\Omega = 2A^T\dot{\mathbf n}`.
-``rigid``, ``particles``  particle positions, :math:`g_{ij}`, multipliers.
-``axis-angle``, ``angle``, ``asymptotic``  unit axis :math:`\mathbf k`
-                 (rational parametrisation), angle :math:`\alpha` (rationalised
-                 by :math:`\alpha = 2\arctan\tau`), :math:`\mathbf n = r\mathbf e`.
+``plain``
+    :math:`\mathbf n` only.
+``velocity``
+    :math:`(\mathbf n, \dot{\mathbf n})`; ``Omega``, ``omega``
+    from :math:`R^T\dot R`, :math:`\dot RR^T`; ``EL``,
+    ``Gamma2``, ``ddt``, ``on_shell`` for the geodesic footnote.
+``canonical``
+    :math:`(\mathbf n, \boldsymbol\pi)`; ``H``, ``m``,
+    ``Omega``, ``M``, ``ndot``, ``Omegadot`` derived; ``PB``.
+``nm``, ``nOmega``, ``nM``
+    the non-canonical charts; ``pi`` is
+    :math:`\boldsymbol\pi(\mathbf n, X)`, ``PBnX``, ``PBXX``, ``P``
+    the brackets and Poisson tensor.
+``phase-velocity``
+    :math:`(\mathbf n,\boldsymbol\pi,\dot{\mathbf n},\dot{\boldsymbol\pi})`.
+``kinematic``
+    :math:`(\mathbf n, \boldsymbol\Omega)` with
+    :math:`\dot{\mathbf n}` solving :math:`\boldsymbol\Omega = 2A^T\dot{\mathbf n}`.
+``rigid``, ``particles``
+    particle positions, :math:`g_{ij}`, multipliers.
+``axis-angle``, ``angle``, ``asymptotic``
+    unit axis :math:`\mathbf k`
+    (rational parametrisation), angle :math:`\alpha` (rationalised
+    by :math:`\alpha = 2\arctan\tau`), :math:`\mathbf n = r\mathbf e`.
 
 References
 ----------
@@ -54,15 +62,16 @@ import json
 import os
 import random
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
+from ..errors import EulerPoissonError, InvalidInputError
+from ..io.atomic import atomic_write_text
 from . import symbolic as _sym
 from .entries import ENTRIES, CheckSpec, EntrySpec
-from ..io.atomic import atomic_write_text
-from ..errors import EulerPoissonError, InvalidInputError
 
 __all__ = [
     "AuditError",
@@ -103,7 +112,7 @@ class AuditError(EulerPoissonError, RuntimeError):
 # ---------------------------------------------------------------------------
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _compile(src: str):
     from sympy.parsing.sympy_parser import auto_number, stringify_expr
 
@@ -126,7 +135,9 @@ class _T3:
 
 
 def _split_chain(src: str) -> list[str]:
-    parts, depth, cur, i = [], 0, [], 0
+    parts: list[str] = []
+    cur: list[str] = []
+    depth, i = 0, 0
     while i < len(src):
         c = src[i]
         if c in "([{":
@@ -337,6 +348,7 @@ class _Session:
                 ns["ndot_of_pi"] = D.velocity_of_momenta
                 ns["L_of_pi"] = D.L.xreplace(dict(zip(D.ndot, D.velocity_of_momenta)))
             else:
+                assert own is not None  # chart is "nm", "nOmega" or "nM" here
                 ns[own] = {"nm": D.m_sym, "nOmega": D.Omega_sym, "nM": D.M_sym}[chart]
                 ns["PBnX"], ns["PBXX"] = D.brackets(chart)
                 ns["P"] = D.poisson_tensor(chart)
@@ -712,10 +724,10 @@ def _compare(p_list, d_list, ns, rng, symbolic=True) -> _Cmp:
                 methods.append("simplify")
             except Exception:  # pragma: no cover - defensive
                 exact = None
-    syms = set()
+    free = set()
     for x in diffs:
-        syms |= x.free_symbols
-    syms = sorted(syms, key=lambda s: s.name)
+        free |= x.free_symbols
+    syms = sorted(free, key=lambda s: s.name)
     numeric_equal = True
     witness = None
     differing = []
@@ -801,7 +813,7 @@ class CheckResult:
 
 @dataclass
 class EntryResult:
-    """Audit outcome of one :class:`EntrySpec` (see :meth:`to_dict` for the JSON fields)."""
+    """Audit outcome of one :class:`EntrySpec` (see ``to_dict()`` for the JSON fields)."""
 
     spec: EntrySpec
     status: str
@@ -1031,7 +1043,7 @@ def _constant_ratio(side_vals, d_vals, refs):
     """If every failing printed side is a constant multiple of the derived value, return it."""
     sp = _sp()
     ratio = None
-    for i, vals, ref in refs:
+    for _i, vals, ref in refs:
         for p, d in zip(vals, ref):
             try:
                 if _sym.is_zero(d):
@@ -1063,7 +1075,7 @@ def _short_difference(dv, D) -> str:
     if rational and D.inertia == "general" and dv.free_symbols & set(D.inertia_symbols):
         cands.append(None)
     out = None
-    for i, c in enumerate(cands):
+    for _i, c in enumerate(cands):
         if c is None:
             c = _sym.rsimp(dv.xreplace(_diag_rep(D)))
             suffix = r"\ \text{(for } I=\mathrm{diag}(I_1,I_2,I_3))"
@@ -1224,12 +1236,12 @@ def _series_residual_zero(D, coeffs, inertia_rep, order) -> tuple[bool, int]:
     sp = _sp()
     inertia_rep = {k: sp.Rational(v) for k, v in (inertia_rep or {}).items()}
     phase = list(D.n) + list(D.pi)
-    csyms = set()
+    free = set()
     for e in list(coeffs):
-        csyms |= e.free_symbols
+        free |= e.free_symbols
     if not inertia_rep:
-        csyms |= set(D.inertia_symbols)
-    csyms = sorted(csyms - set(phase), key=lambda s: s.name)
+        free |= set(D.inertia_symbols)
+    csyms = sorted(free - set(phase), key=lambda s: s.name)
     known = [D.detI] if (D.inertia == "general" and not inertia_rep) else []
     ctx = _sym._Ctx(phase + csyms, known)
     # Hamilton's vector field (dH/dpi, -dH/dn) of the derived H, moved into this ring
@@ -1288,7 +1300,7 @@ def _transfer(rat, src, dst, values):
     ng = len(dst.symbols)
 
     def move(poly):
-        terms = {}
+        terms: dict[tuple[int, ...], Any] = {}
         for monom, c in poly.terms():
             new = [0] * ng
             for (kind, v), e in zip(pos, monom):
@@ -1305,7 +1317,7 @@ def _transfer(rat, src, dst, values):
         return dst.ring.from_dict({k: v for k, v in terms.items() if v})
 
     num = move(rat.num)
-    den = {}
+    den: dict[int, int] = {}
     for k, e in rat.den.items():
         fpoly = move(src.factors[k])
         c, exps = dst.factor_known(fpoly)
@@ -1323,7 +1335,7 @@ def _lie_symbolic_check(D, order):
     ok, deg = _series_residual_zero(D, C, None, order)
     return ok, (
         f"order {order}, symbolic {D.inertia} inertia and symbolic pi0 ({', '.join(map(str, pi0))}): "
-        + ("residual of Hamilton's equations is O(t^%d)" % order if ok else f"residual has a t^{deg} term")
+        + (f"residual of Hamilton's equations is O(t^{order})" if ok else f"residual has a t^{deg} term")
     )
 
 
@@ -1504,6 +1516,12 @@ class AuditReport:
     def to_latex(self) -> str:
         """A complete standalone LaTeX document (article, longtable)."""
         return _to_latex(self)
+
+    def _repr_html_(self) -> str:
+        """A compact HTML table for notebooks: :func:`eulerpoisson.util.htmlrepr.audit_html`."""
+        from ..util.htmlrepr import audit_html
+
+        return audit_html(self)
 
 
 def _jsonable(x):
@@ -1840,7 +1858,7 @@ def _tex_math_block(s: str) -> str:
     return "\n".join(out)
 
 
-def write_report(report: AuditReport, fmt: str, path) -> str:
+def write_report(report: AuditReport, fmt: str, path: str | os.PathLike[str]) -> str:
     """Write a report atomically (temporary file in the target directory, then :func:`os.replace`).
 
     Parameters

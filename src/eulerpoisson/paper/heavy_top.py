@@ -67,6 +67,7 @@ import functools
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
@@ -102,8 +103,8 @@ class HeavyTopDerivation:
     ``(3, 1)`` / ``(3, 3)`` / ``(6, 1)`` matrix) whose denominators are powers
     of :math:`1+\mathbf n^2` and :math:`\det I`.
 
-    Symbols
-    -------
+    Attributes
+    ----------
     n, ndot, pi : the Gibbs vector, its velocity and the canonical momenta
         (shared with :func:`eulerpoisson.paper.symbolic.derive`).
     mass, c, g : :math:`\mu` (symbol ``mu``), the centre of mass
@@ -369,7 +370,7 @@ class HeavyTopDerivation:
         "vertical_momentum_conserved",
     )
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache  # noqa: B019 - one instance per inertia case, kept for the process by derive_heavy_top()'s cache
     def identity(self, name: str) -> bool:
         r"""Exact check of one identity (True when it holds identically).
 
@@ -410,7 +411,7 @@ class HeavyTopDerivation:
     # -- exact evaluation ----------------------------------------------------------
     def _values(self, n, pi, inertia, mass, center_of_mass, g):
         sp = _S._sympy()
-        vals = {}
+        vals: dict[Any, Any] = {}
         vals.update(zip(self.n, _exact_vector(n, "n")))
         vals.update(zip(self.pi, _exact_vector(pi, "pi")))
         vals.update(zip(self.c, _exact_vector(center_of_mass, "center_of_mass")))
@@ -532,7 +533,7 @@ def _exact_inertia(inertia, kind):
     return M
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def derive_heavy_top(inertia: str = "general") -> HeavyTopDerivation:
     r"""The heavy top's canonical equations in the Gibbs vector, derived from :math:`L = \tfrac12\dot{\mathbf n}^TG\dot{\mathbf n} - U`.
 

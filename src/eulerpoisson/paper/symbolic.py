@@ -53,9 +53,10 @@ import functools
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Sequence
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError, require
 
@@ -445,7 +446,7 @@ class _Ctx:
         """Write ``p = c * prod f_k^e_k`` over the known factors (adding a new one if needed)."""
         if p == 0:
             raise InvalidInputError("division by zero (identically vanishing denominator)")
-        exps = {}
+        exps: dict[int, int] = {}
         for i, f in enumerate(self.factors):
             while not p.is_ground:
                 q, r = p.div(f)
@@ -522,7 +523,7 @@ class _Ctx:
         R = self.ring
         idxs = [self.index[s] for s in mapping]
         vals = [mapping[s] for s in mapping]
-        E = {}
+        E: dict[int, int] = {}
         for v in vals:
             for k, e in v.den.items():
                 E[k] = max(E.get(k, 0), e)
@@ -771,12 +772,12 @@ def _rinv3(F):
     factors by trial division: no gcd anywhere.
     """
     ctx = F[0][0].ctx
-    E = {}
+    E: dict[int, int] = {}
     for row in F:
         for x in row:
             for k, e in x.den.items():
                 E[k] = max(E.get(k, 0), e)
-    P = [[None] * 3 for _ in range(3)]
+    P: list[list[Any]] = [[None] * 3 for _ in range(3)]
     for i in range(3):
         for j in range(3):
             p = F[i][j].num
@@ -797,7 +798,7 @@ def _rinv3(F):
     for k, e in E.items():
         Dpoly = Dpoly * ctx.fpow(k, e)
     scale = Dpoly * (1 / c)
-    out = [[None] * 3 for _ in range(3)]
+    out: list[list[Any]] = [[None] * 3 for _ in range(3)]
     for i in range(3):
         for j in range(3):
             r = [a for a in range(3) if a != j]
@@ -817,8 +818,8 @@ class Derivation:
     :math:`1+\mathbf n^2` and :math:`\det I` (computations run on polynomial
     numerators over these known factors, no gcd needed).
 
-    Symbols
-    -------
+    Attributes
+    ----------
     n, ndot, nddot : Gibbs vector :math:`\mathbf n = \mathbf k\tan(\alpha/2)`
         and its time derivatives (columns of symbols ``n1..``, ``ndot1..``).
     pi : canonical momenta :math:`\pi_i` (symbols ``pi1..``).
@@ -853,7 +854,7 @@ class Derivation:
             names = ("I11", "I12", "I13", "I22", "I23", "I33")
             I11, I12, I13, I22, I23, I33 = sp.symbols(names, real=True)
             self.I = sp.Matrix([[I11, I12, I13], [I12, I22, I23], [I13, I23, I33]])
-            self.inertia_symbols = (I11, I12, I13, I22, I23, I33)
+            self.inertia_symbols: tuple[Any, ...] = (I11, I12, I13, I22, I23, I33)
         else:
             I1, I2, I3 = sp.symbols("I1:4", positive=True)
             self.I = sp.diag(I1, I2, I3)
@@ -1226,7 +1227,7 @@ class Derivation:
         out = {}
         for chart, coord in (("nm", self._fm_c), ("nOmega", self._fOmega_c), ("nM", self._fM_c)):
             nX = [[self._fbracket(a, b) for b in coord] for a in self._fn]
-            XX = [[None] * 3 for _ in range(3)]
+            XX: list[list[Any]] = [[None] * 3 for _ in range(3)]
             for i in range(3):
                 XX[i][i] = self.ctx.const(0)
                 for j in range(i + 1, 3):
@@ -1239,7 +1240,7 @@ class Derivation:
         nX, XX = self._fbr[chart]
         return self._chart(nX, chart), self._chart(XX, chart)
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache  # noqa: B019 - one instance per inertia case, kept for the process by derive()'s own cache
     def brackets(self, chart: str):
         r"""(``{n_i, X_j}``, ``{X_i, X_j}``) as SymPy matrices in the chart ``"nm"``, ``"nOmega"`` or ``"nM"``.
 
@@ -1282,7 +1283,7 @@ class Derivation:
             return [self._fbracket(x, self._fH) for x in base]
         raise InvalidInputError(f"quantity name must be one of {self._QUANTITIES}, got {name!r}")
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache  # noqa: B019 - one instance per inertia case, kept for the process by derive()'s own cache
     def quantity(self, name: str, chart: str = "canonical"):
         r"""A phase-space quantity as a function of the chart's variables.
 
@@ -1330,7 +1331,7 @@ class Derivation:
         return sp.BlockMatrix([[Z, B], [-B.T, C]]).as_explicit()
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def derive(inertia: str = "general") -> Derivation:
     r"""The (cached) derivation of the paper's quantities.
 
@@ -1463,10 +1464,10 @@ def _lie_coefficients(order, K, pi0, n0, back):
         d, _ = back
         extra = [s for s in d.inertia_symbols if s not in params]
         known = [d.detI] if d.inertia == "general" else list(d.inertia_symbols)
-    params = sorted(params, key=lambda s: s.name)
+    ordered = sorted(params, key=lambda s: s.name)
     dsyms = sp.symbols("_d1:4")
     psyms = sp.symbols("_p1:4")
-    ctx = _Ctx(list(dsyms) + list(psyms) + params + extra, known)
+    ctx = _Ctx(list(dsyms) + list(psyms) + ordered + extra, known)
     R = ctx.ring
     d_ = [ctx.gens[x] for x in dsyms]
     p_ = [ctx.gens[x] for x in psyms]
@@ -1607,6 +1608,7 @@ def taylor_coefficients(order: int, inertia=None, pi0=None, n0=None, *, as_float
     """
     sp = _sympy()
     order = _check_order(order)
+    ikey: str | tuple[Any, ...]
     if inertia is None or isinstance(inertia, str):
         ikey = "general" if inertia is None else inertia
         _inverse_inertia(ikey)  # validates the string
@@ -1733,7 +1735,7 @@ class LieSeriesCheck:
         return self.order + 1
 
 
-def check_lie_series(order: int, inertia, pi0, n0=None, times: Sequence[float] | None = None) -> LieSeriesCheck:
+def check_lie_series(order: int, inertia, pi0, n0=None, times: ArrayLike | None = None) -> LieSeriesCheck:
     r"""Compare the truncated Lie series with a numeric solution of eq. 1.16.
 
     The reference is :func:`scipy.integrate.solve_ivp` (DOP853, ``rtol=1e-13``,

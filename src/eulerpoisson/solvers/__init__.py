@@ -10,6 +10,9 @@ r"""Solution methods and the ``solve`` driver.
 A new method is one new folder here plus its import below.
 """
 
+from . import exact, rk, symplectic, taylor  # noqa: F401  (importing registers the methods)
+from .driver import solve
+from .exact.method import ExactOptions
 from .problem import Problem, compose_initial, make_problem
 from .registry import (
     Method,
@@ -21,9 +24,6 @@ from .registry import (
     methods_supporting,
     register_method,
 )
-from . import exact, rk, symplectic, taylor  # noqa: F401  (importing registers the methods)
-from .driver import solve
-from .exact.method import ExactOptions
 from .rk.method import RKOptions
 from .symplectic.method import SymplecticOptions
 from .taylor.method import TaylorOptions

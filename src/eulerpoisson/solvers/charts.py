@@ -80,6 +80,7 @@ ed., Springer (2006), sections VI.5 (cotangent lifts), VII.5 (the rigid body).
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -541,7 +542,7 @@ def run_fixed_step(t, dt, state0, advance, output):
     """
     t = np.asarray(t, dtype=float)
     T = t.shape[0]
-    results = [None] * T
+    results: list[Any] = [None] * T
     nsteps_total = 0
     order = np.argsort(t, kind="stable")
     pos = [int(i) for i in order if t[i] >= 0]

@@ -14,8 +14,10 @@ the exponential of the Hamiltonian vector field).
 from __future__ import annotations
 
 import time as _time
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
 from ..trajectory import Trajectory
@@ -23,11 +25,17 @@ from .parallel import check_workers, solve_batch
 from .problem import make_problem
 from .registry import MethodOptions, check_supported, get_method
 
+if TYPE_CHECKING:
+    from ..attitude.core import AttitudeLike
+    from ..model.body import RigidBody
+    from ..model.equations import Model
+    from ..model.torques import TorqueLike
+
 __all__ = ["solve"]
 
 
-def solve(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None, method="exact", workers=None,
-          **options):
+def solve(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLike | None = None, m0: ArrayLike | None = None, attitude0: AttitudeLike | None = None, gibbs0: ArrayLike | None = None, torque: TorqueLike = None, method: str | MethodOptions = "exact", workers: int | None = None,
+          **options: Any) -> Trajectory:
     r"""Motion of rigid bodies, free or under torque, at the output times ``t``.
 
     Parameters

@@ -99,7 +99,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..model.equations import Model
-from ..trajectory import _stored_attitudes
+from ..trajectory import stored_attitudes
 from .problem import Problem
 from .registry import Method, MethodResult
 
@@ -228,6 +228,7 @@ def take(problem: Problem, start: int, stop: int) -> Problem:
     parameters (a single body, a torque without batch axes) stay shared.
     """
     shape = problem.batch_shape
+    index: tuple
     if len(shape) == 1:
         index = (slice(start, stop),)
     else:
@@ -313,7 +314,7 @@ def _run_threads(method: Method, problem: Problem, bounds: list[tuple[int, int]]
         res = method.run(take(problem, a, b))
         qc = res.q.reshape(b - a, T, 4)
         wc = res.omega.reshape(b - a, T, 3)
-        q[a:b] = _stored_attitudes(problem.t, qc, wc)
+        q[a:b] = stored_attitudes(problem.t, qc, wc)
         w[a:b] = wc
         return res.stats
 

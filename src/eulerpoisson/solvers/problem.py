@@ -7,8 +7,10 @@ r"""The initial value problem every solution method receives: :class:`Problem`.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..attitude.core import Attitude, as_quaternion
 from ..errors import InvalidInputError
@@ -16,6 +18,10 @@ from ..model.body import RigidBody
 from ..model.equations import Model, as_model
 from ..numerics.quaternion import qmul
 from ..util.validate import as_float_array
+
+if TYPE_CHECKING:
+    from ..attitude.core import AttitudeLike
+    from ..model.torques import TorqueLike
 
 __all__ = ["Problem", "make_problem", "initial_quaternion", "compose_initial"]
 
@@ -29,9 +35,9 @@ class Problem:
     model : Model
         The equations: bodies and torques, batch shape broadcastable to
         ``batch_shape``.
-    q0 : ndarray, shape (*batch_shape, 4)
+    q0 : ndarray, shape ``(*batch_shape, 4)``
         Initial attitudes (unit quaternions, scalar first).
-    omega0 : ndarray, shape (*batch_shape, 3)
+    omega0 : ndarray, shape ``(*batch_shape, 3)``
         Initial body angular velocities, in the body frame of ``body.inertia``.
     t : ndarray, shape (T,)
         Output times, any order, negative allowed.
@@ -39,6 +45,17 @@ class Problem:
         ``"omega0"``, ``"q0"``: the initial state as given in long double,
         broadcast like ``omega0``/``q0`` (only when it was given so), for
         methods that compute in extended precision.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.solvers import make_problem
+    >>> p = make_problem([1.0, 2.0, 2.5], [0.0, 1.0, 2.0], omega0=[[1.0, 0.1, 0.5], [0.0, 1.0, 0.0]])
+    >>> type(p).__name__, p.q0.shape, p.omega0.shape, p.t.shape
+    ('Problem', (2, 4), (2, 3), (3,))
+    >>> print(p.q0)
+    [[1. 0. 0. 0.]
+     [1. 0. 0. 0.]]
     """
 
     model: Model
@@ -49,7 +66,7 @@ class Problem:
 
     @property
     def body(self) -> RigidBody:
-        """The bodies (the free-body part of :attr:`model`)."""
+        """The bodies (the free-body part of ``model``)."""
         return self.model.body
 
     @property
@@ -58,7 +75,7 @@ class Problem:
 
     @property
     def inertia(self) -> np.ndarray:
-        """Inertia tensors broadcast to the batch, (*batch_shape, 3, 3)."""
+        """Inertia tensors broadcast to the batch, ``(*batch_shape, 3, 3)``."""
         return np.broadcast_to(self.body.inertia, self.batch_shape + (3, 3))
 
     @property
@@ -71,7 +88,7 @@ class Problem:
 
     @property
     def M0(self) -> np.ndarray:
-        """Initial body angular momentum, (*batch_shape, 3)."""
+        """Initial body angular momentum, ``(*batch_shape, 3)``."""
         return np.einsum("...ij,...j->...i", self.inertia, self.omega0)
 
 
@@ -82,7 +99,7 @@ def _as_times(t) -> np.ndarray:
     return np.atleast_1d(ta)
 
 
-def initial_quaternion(attitude0=None, gibbs0=None) -> np.ndarray:
+def initial_quaternion(attitude0: AttitudeLike | None = None, gibbs0: ArrayLike | None = None) -> np.ndarray:
     """The initial attitude as unit quaternions (..., 4) from what :func:`solve` accepts.
 
     ``attitude0``: an :class:`~eulerpoisson.Attitude`, a scipy ``Rotation`` or
@@ -121,13 +138,20 @@ def initial_quaternion(attitude0=None, gibbs0=None) -> np.ndarray:
     return as_quaternion(q0, "attitude0")
 
 
-def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, torque=None) -> Problem:
+def make_problem(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLike | None = None, m0: ArrayLike | None = None, attitude0: AttitudeLike | None = None, gibbs0: ArrayLike | None = None, torque: TorqueLike = None) -> Problem:
     """Validate and broadcast the arguments of :func:`solve` into a :class:`Problem`.
 
     Raises
     ------
     TypeError, InvalidInputError
         See :func:`solve`.
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers import make_problem
+    >>> p = make_problem([1.0, 2.0, 2.5], [0.0, 5.0], m0=[0.0, 0.0, 2.5])   # from the spatial momentum
+    >>> print(p.omega0, p.model.is_free)
+    [0. 0. 1.] True
     """
     model = as_model(body, torque)
     body = model.body
@@ -167,10 +191,21 @@ def make_problem(body, t, *, omega0=None, m0=None, attitude0=None, gibbs0=None, 
 def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
     r"""Attitudes :math:`q_0\otimes q_\mathrm{rel}(t)` for relative motions starting at the identity.
 
-    ``q_rel`` has shape (*batch_shape, T, 4); left invariance of the free body
+    ``q_rel`` has shape ``(*batch_shape, T, 4)``; left invariance of the free body
     makes this the motion from ``q0`` (a free-body shortcut: only valid when
     ``problem.model.is_free``, which is checked). When every ``q0`` is the identity,
     ``q_rel`` is returned as it is (the product would only copy it).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.solvers import compose_initial, make_problem
+    >>> q0 = [np.cos(0.25), np.sin(0.25), 0.0, 0.0]                 # 0.5 rad about x
+    >>> p = make_problem([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.0, 0.0], attitude0=q0)
+    >>> q_rel = np.array([[1.0, 0.0, 0.0, 0.0], [np.cos(0.25), np.sin(0.25), 0.0, 0.0]])
+    >>> print(np.round(compose_initial(p, q_rel), 9))               # q0, then q0 q_rel: 1 rad about x
+    [[0.96891242 0.24740396 0.         0.        ]
+     [0.87758256 0.47942554 0.         0.        ]]
     """
     if not problem.model.is_free:
         raise ValueError("compose_initial is a free-body shortcut (left invariance); the model has torques")

@@ -30,7 +30,7 @@ __all__ = [
     "check_supported",
 ]
 
-_REGISTRY: dict[str, type["Method"]] = {}
+_REGISTRY: dict[str, type[Method]] = {}
 
 
 @dataclass
@@ -39,8 +39,8 @@ class MethodResult:
 
     Attributes
     ----------
-    q : ndarray, shape (*batch_shape, T, 4)
-    omega : ndarray, shape (*batch_shape, T, 3)
+    q : ndarray, shape ``(*batch_shape, T, 4)``
+    omega : ndarray, shape ``(*batch_shape, T, 3)``
     stats : dict
         Method-specific counters (steps, function evaluations, chart changes...).
     prepared : bool
@@ -48,6 +48,14 @@ class MethodResult:
         ``omega`` were checked and ``q`` stored as a
         :class:`~eulerpoisson.trajectory.Trajectory` stores it, chunk by
         chunk, in the threads that solved them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.solvers import MethodResult
+    >>> res = MethodResult(q=np.tile([1.0, 0.0, 0.0, 0.0], (2, 1)), omega=np.zeros((2, 3)), stats={"steps": 0})
+    >>> res.q.shape, res.omega.shape, res.stats, res.prepared
+    ((2, 4), (2, 3), {'steps': 0}, False)
     """
 
     q: np.ndarray
@@ -65,6 +73,20 @@ class MethodOptions:
     options object is always valid; :meth:`replace` makes a validated copy.
     Pass one as ``solve(..., method=TaylorOptions(tol=1e-12))``: the class
     knows its method (:attr:`method`).
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers import MethodOptions, TaylorOptions
+    >>> opts = TaylorOptions(tol=1e-12)
+    >>> isinstance(opts, MethodOptions), opts.method
+    (True, 'taylor')
+    >>> opts.replace(order=20).to_dict()["order"]
+    20
+    >>> try:
+    ...     opts.replace(tolerance=1e-9)
+    ... except TypeError as err:
+    ...     print(err)
+    method 'taylor' got unknown option(s) tolerance; allowed: chart_threshold, dps, dt, max_steps, order, precision, tol
     """
 
     #: name of the method these options belong to
@@ -95,7 +117,7 @@ class MethodOptions:
         """The default value of every option."""
         return {f.name: f.default for f in fields(cls)}
 
-    def replace(self, **changes) -> "MethodOptions":
+    def replace(self, **changes: Any) -> MethodOptions:
         """A validated copy with some options changed.
 
         Raises
@@ -123,8 +145,8 @@ class Method:
     they can run. Constructed from an ``Options`` instance and/or keyword
     options: an unknown option raises ``TypeError`` naming it.
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         Registry key used by ``solve(..., method=name)``.
     Options : type
@@ -147,13 +169,20 @@ class Method:
         steps): added over the chunks of a batch solved in threads; every
         other number is the largest over the chunks (a per-body maximum or a
         value that every chunk shares), every other value the first chunk's.
-
-    Attributes
-    ----------
     opts : MethodOptions
         The validated options of this instance.
     config : dict
         The same as a dict.
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers import Method, get_method
+    >>> rk = get_method("rk")
+    >>> issubclass(rk, Method), rk.name, rk.order
+    (True, 'rk', 8)
+    >>> m = rk(tol=1e-12)                                           # options validated
+    >>> m.config["tol"], m.config["integrator"]
+    (1e-12, 'DOP853')
     """
 
     name: ClassVar[str] = ""
@@ -166,7 +195,7 @@ class Method:
     threads: ClassVar[bool] = True
     additive_stats: ClassVar[tuple[str, ...]] = ("evaluations",)
 
-    def __init__(self, options: MethodOptions | None = None, /, **kwargs):
+    def __init__(self, options: MethodOptions | None = None, /, **kwargs: Any) -> None:
         if options is not None:
             if not isinstance(options, self.Options):
                 raise TypeError(
@@ -186,7 +215,7 @@ class Method:
     def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def for_batch(self, problem: Problem) -> "Method":
+    def for_batch(self, problem: Problem) -> Method:
         """This method with every choice that depends on the whole batch made on ``problem``.
 
         Before a batch is split into chunks solved in threads (:mod:`.parallel`),
@@ -194,8 +223,9 @@ class Method:
         method on every chunk: whatever a method decides from the batch as a
         whole (a default step from the fastest body, a kernel chosen by the
         number of bodies) must be decided here, once, so that every body gets
-        the same bits whatever the chunks. The default (no such choice):
-        ``self``.
+        the same bits whatever the chunks (the compiled kernels or their
+        NumPy twins, :meth:`numpy_estimate`, included). The default (no such
+        choice): ``self``.
         """
         return self
 
@@ -207,6 +237,20 @@ class Method:
         """
         B = int(np.prod(problem.batch_shape, dtype=int))
         return 0.5e-6 * B * (1 + problem.t.shape[0])
+
+    def numpy_estimate(self, problem: Problem) -> float:
+        """Rough seconds that the NumPy twin of the method's compiled kernels takes on ``problem``.
+
+        Below :data:`~eulerpoisson.util.jit.NUMPY_BELOW` (a small problem)
+        a method with such a twin runs it, without importing numba
+        (:func:`~eulerpoisson.util.jit.use_compiled`): numba and a kernel
+        loaded from its cache cost about half a second in a fresh process.
+        The choice is made for the whole batch (:meth:`for_batch`), so that
+        the chunks solved in threads take the same path. The default
+        (``inf``): no twin worth running, the compiled kernels whenever
+        numba is in use.
+        """
+        return float("inf")
 
     @classmethod
     def supports(cls, model: Model) -> str | None:
@@ -220,7 +264,32 @@ class Method:
 
 
 def register_method(cls: type[Method]) -> type[Method]:
-    """Class decorator: register a :class:`Method` subclass under ``cls.name``."""
+    """Class decorator: register a :class:`Method` subclass under ``cls.name``.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from dataclasses import dataclass
+    >>> from eulerpoisson.solvers import Method, MethodOptions, MethodResult, register_method
+    >>> @dataclass(frozen=True)
+    ... class StillOptions(MethodOptions):
+    ...     method = "still"
+    >>> @register_method
+    ... class Still(Method):
+    ...     # a body that does not move (an example)
+    ...     name, Options = "still", StillOptions
+    ...     def run(self, problem):
+    ...         T = problem.t.shape[0]
+    ...         q = np.broadcast_to(problem.q0[..., None, :], problem.q0.shape[:-1] + (T, 4))
+    ...         return MethodResult(q=q.copy(), omega=np.zeros(q.shape[:-1] + (3,)))
+    >>> "still" in ep.available_methods()
+    True
+    >>> print(ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.0, 0.0], method="still").omega)
+    [[0. 0. 0.]
+     [0. 0. 0.]]
+    >>> from eulerpoisson.solvers.registry import _REGISTRY
+    >>> _ = _REGISTRY.pop("still")                                   # the registry as it was
+    """
     if not cls.name:
         raise ValueError("a registered method needs a name")
     cls.options = cls.Options.defaults()
@@ -229,12 +298,29 @@ def register_method(cls: type[Method]) -> type[Method]:
 
 
 def available_methods() -> list[str]:
-    """Names accepted by ``solve(..., method=...)``."""
+    """Names accepted by ``solve(..., method=...)``.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> ep.available_methods()
+    ['exact', 'rk', 'symplectic', 'taylor']
+    """
     return sorted(_REGISTRY)
 
 
 def methods_supporting(model: Model) -> list[str]:
-    """Names of the registered methods that can run ``model``."""
+    """Names of the registered methods that can run ``model``.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.solvers import methods_supporting
+    >>> methods_supporting(ep.Model([1.0, 2.0, 2.5]))
+    ['exact', 'rk', 'symplectic', 'taylor']
+    >>> methods_supporting(ep.Model([1.0, 2.0, 2.5], lambda t, q, omega: -0.1 * omega))
+    ['rk']
+    """
     return sorted(name for name, cls in _REGISTRY.items() if cls.supports(model) is None)
 
 
@@ -245,6 +331,18 @@ def check_supported(name: str, model: Model) -> None:
     ------
     UnsupportedModelError
         Naming the method, the reason and the methods that can run the model.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.solvers import check_supported
+    >>> check_supported("taylor", ep.Model([1.0, 2.0, 2.5], ep.torques.BodyTorque([0.0, 0.0, 0.1])))   # fine: None
+    >>> try:
+    ...     check_supported("exact", ep.Model([1.0, 2.0, 2.5], ep.torques.BodyTorque([0.0, 0.0, 0.1])))
+    ... except ep.UnsupportedModelError as err:
+    ...     print(err)
+    method 'exact' cannot run this model: the closed form covers the free body and the Lagrange top ...;
+    methods that can: rk, symplectic, taylor
     """
     reason = get_method(name).supports(model)
     if reason is None:
@@ -261,6 +359,17 @@ def get_method(name: str) -> type[Method]:
     ------
     InvalidInputError
         Unknown method name (the message lists the available ones).
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers import get_method
+    >>> get_method("taylor").__name__, get_method("taylor").refine
+    ('Taylor', 'dt')
+    >>> try:
+    ...     get_method("euler")
+    ... except ValueError as err:
+    ...     print(err)
+    unknown method 'euler'; available methods: exact, rk, ...
     """
     if not isinstance(name, str) or name not in _REGISTRY:
         raise InvalidInputError(

@@ -114,17 +114,18 @@ import os
 import shutil
 import time as _time
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..errors import EulerPoissonError, InvalidInputError, require
 from ..io.stream import (
+    ProgressDisplay,
     _check_replaceable,
     _done_chunks,
     _mark_done,
-    ProgressDisplay,
     _quiet_zarr,
     _replace_dir,
     _work_dir,
@@ -195,6 +196,7 @@ def _axis_spec(v, where: str, kind: str, positive: bool) -> dict:
         log = v.get("log", False)
         if not isinstance(log, bool):
             raise InvalidInputError(f"{where}.log must be true or false, got {log!r}")
+        num: int | None
         if kind == "grid":
             if "num" not in v:
                 raise InvalidInputError(f"{where}: a grid range needs 'num' (the number of values)")
@@ -241,6 +243,15 @@ class SweepConfig:
     scheduler : str
     workers : int or None
     method : str
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import load_config
+    >>> cfg = load_config({"inertia": {"I1": 1.0, "I2": 2.0, "I3": 2.5},
+    ...                    "momentum": {"polar": [10.0, 80.0], "azimuth": 0.0},
+    ...                    "output": {"path": "atlas.zarr"}, "compute": {"T": 10.0, "scheduler": "serial"}})
+    >>> type(cfg).__name__, cfg.kind, cfg.T, cfg.scheduler, cfg.chunk
+    ('SweepConfig', 'grid', 10.0, 'serial', 256)
     """
 
     kind: str
@@ -275,6 +286,7 @@ class SweepConfig:
     @property
     def n_points(self) -> int:
         if self.kind == "random":
+            assert self.samples is not None  # required for kind = 'random'
             return int(self.samples)
         return int(np.prod([len(v) for v in self.grid_axes.values()]))
 
@@ -296,7 +308,7 @@ class SweepConfig:
             "method": self.method,
         }
 
-    def replace(self, **changes) -> "SweepConfig":
+    def replace(self, **changes) -> SweepConfig:
         d = {k: copy.deepcopy(getattr(self, k)) for k in self.__dataclass_fields__}
         d.update(changes)
         return SweepConfig(**d)
@@ -336,6 +348,24 @@ def load_config(source) -> SweepConfig:
     InvalidInputError
         Invalid TOML, an unknown section or key, a missing key, a value of
         the wrong type or out of range; the message names ``[section] key``.
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import load_config
+    >>> toml = ["[inertia]", "I1 = 1.0", "I2 = {start = 1.5, stop = 2.5, num = 3}", "I3 = 3.0",
+    ...         "[momentum]", "polar = 45.0", "azimuth = 30.0",
+    ...         "[output]", 'path = "atlas.zarr"', "[compute]", "T = 20.0"]
+    >>> with open("sweep.toml", "w") as fh:
+    ...     for line in toml:
+    ...         print(line, file=fh)
+    >>> cfg = load_config("sweep.toml")
+    >>> cfg.inertia["I2"], cfg.path
+    ({'range': {'start': 1.5, 'stop': 2.5, 'num': 3, 'log': False}}, 'atlas.zarr')
+    >>> try:
+    ...     load_config({"inertia": {"I1": 1.0}})
+    ... except ValueError as err:
+    ...     print(err)
+    <dict>: missing section [momentum]
     """
     if isinstance(source, dict):
         cfg, name = source, "<dict>"
@@ -469,6 +499,7 @@ def _grid_points(cfg: SweepConfig, a: int, b: int) -> dict:
 def _random_points(cfg: SweepConfig) -> dict:
     rng = np.random.default_rng(cfg.seed)
     n = cfg.samples
+    assert n is not None  # required for kind = 'random'
     vals = {}
     for name in cfg.axis_names:
         spec = {**cfg.inertia, "polar": cfg.polar, "azimuth": cfg.azimuth}[name]
@@ -544,13 +575,23 @@ def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = 
     -----
     Pure function of its inputs: the same chunk gives the same bits on any
     worker.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.sweep import compute_points
+    >>> inertia = [[1.0, 2.0, 3.0], [1.0, 2.0, 3.0], [2.0, 2.0, 3.0]]
+    >>> M0 = [[0.1, 0.0, 1.0], [0.0, 1.0, 0.1], [0.0, 1.0, 0.1]]    # near axis 3, near axis 2, a symmetric body
+    >>> out = compute_points(inertia, M0, T=10.0)
+    >>> print(np.round(out["half_period"], 6), out["status"])
+    [ 9.496682 24.50238        nan] [0 0 2]
     """
-    from ..util.validate import as_float_array, as_scalar
     from scipy.special import ellipkm1
 
     from ..analysis import elliptic_parameters
     from ..model.body import RigidBody
     from ..solvers import solve
+    from ..util.validate import as_float_array, as_scalar
 
     I = as_float_array(inertia, "inertia", (3,)).reshape(-1, 3)
     M = as_float_array(M0, "M0", (3,)).reshape(-1, 3)
@@ -600,13 +641,18 @@ def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = 
     return {"half_period": half, "k2": k2, "sensitivity": sens, "status": status}
 
 
-def _compute_chunk(inertia, M0, T, delta, method, workers=None):
+def _compute_chunk(inertia, M0, T, delta, method, run_points=0, workers=None):
     """One task: ``compute_points`` plus its wall time (module-level, so Dask can ship it by reference).
 
-    ``workers``: threads of the solve; Dask tasks pass 1 (Dask's workers already use the cores).
+    ``run_points``: the points of the whole sweep (each is solved three times), from which the compiled
+    kernels or NumPy are chosen, the same for every chunk. ``workers``: threads of the solve; Dask tasks
+    pass 1 (Dask's workers already use the cores).
     """
+    from ..util.jit import whole_run
+
     start = _time.perf_counter()
-    out = compute_points(inertia, M0, T=T, delta=delta, method=method, workers=workers)
+    with whole_run(n_bodies=3 * int(run_points)):
+        out = compute_points(inertia, M0, T=T, delta=delta, method=method, workers=workers)
     out["seconds"] = _time.perf_counter() - start
     return out
 
@@ -614,7 +660,7 @@ def _compute_chunk(inertia, M0, T, delta, method, workers=None):
 # ---------------------------------------------------------------------------
 # running a sweep
 # ---------------------------------------------------------------------------
-_RESULTS = {
+_RESULTS: dict[str, tuple[str, dict[str, Any]]] = {
     "half_period": ("f8", {"long_name": "flip half-period 2K(k)/lambda (time between flips); inf on the separatrix",
                            "units": "s"}),
     "k2": ("f8", {"long_name": "Jacobi parameter k^2 of the polhode", "units": "1"}),
@@ -647,7 +693,7 @@ def _create_store(zarr, store: Path, cfg: SweepConfig) -> None:
         "T": cfg.T,
         "delta": cfg.delta,
         "method": cfg.method,
-        "history": f"{datetime.now(timezone.utc).isoformat(timespec='seconds')} started by eulerpoisson {__version__}",
+        "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} started by eulerpoisson {__version__}",
     })
 
     def arr(name, dims, shape, chunks, dtype, attrs, fill):
@@ -777,6 +823,18 @@ def run_sweep(
     >>> if __name__ == "__main__":                                  # doctest: +SKIP
     ...     path = run_sweep("examples/sweep.toml", scheduler="local", workers=4)
     ...     plot_atlas(load_sweep(path), "atlas.png")
+
+    >>> import numpy as np
+    >>> from eulerpoisson.sweep import load_sweep, run_sweep
+    >>> cfg = {"inertia": {"I1": 1.0, "I2": 2.0, "I3": 3.0},
+    ...        "momentum": {"polar": [30.0, 60.0], "azimuth": [0.0, 45.0]},
+    ...        "output": {"path": "demo.zarr", "chunk": 2}, "compute": {"T": 10.0, "scheduler": "serial"}}
+    >>> path = run_sweep(cfg, progress=False)
+    >>> path.name
+    'demo.zarr'
+    >>> print(np.round(load_sweep(path)["half_period"].values, 6))
+    [[132.062275  12.438453]
+     [  6.469547   8.917193]]
     """
     zarr = require("zarr", "dask")
     cfg = config if isinstance(config, SweepConfig) else load_config(config)
@@ -860,7 +918,7 @@ def run_sweep(
         _mark_done(work, k, {"seconds": float(res["seconds"])})
 
     n_done = sum(bounds(k)[1] - bounds(k)[0] for k in done)
-    args = (cfg.T, cfg.delta, cfg.method)
+    args = (cfg.T, cfg.delta, cfg.method, n)
     try:
         with ProgressDisplay(progress, n, f"sweep {path.name}") as bar:
             bar.update(n_done)
@@ -878,7 +936,7 @@ def run_sweep(
 
     with _quiet_zarr():
         g.attrs["history"] = (
-            f"{g.attrs.get('history', '')}; finished {datetime.now(timezone.utc).isoformat(timespec='seconds')}"
+            f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
         )
         zarr.consolidate_metadata(str(store))
     _replace_dir(store, path, overwrite)
@@ -963,6 +1021,15 @@ def load_sweep(path, *, squeeze: bool = True):
         Not a sweep store.
     MissingDependencyError
         xarray or zarr missing.
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import load_sweep, run_sweep
+    >>> cfg = {"inertia": {"I1": 1.0, "I2": [1.5, 2.0], "I3": 3.0}, "momentum": {"polar": 40.0, "azimuth": 20.0},
+    ...        "output": {"path": "inertia_line.zarr"}, "compute": {"T": 5.0, "scheduler": "serial"}}
+    >>> ds = load_sweep(run_sweep(cfg, progress=False))
+    >>> dict(ds.sizes), sorted(ds.data_vars)[:4]
+    ({'chunk': 1, 'I2': 2, 'axis': 3}, ['M0', 'chunk_count', 'chunk_seconds', 'chunk_time'])
     """
     xr = require("xarray", "io")
     require("zarr", "dask")
@@ -983,7 +1050,7 @@ def load_sweep(path, *, squeeze: bool = True):
     grid = json.loads(ds.attrs["sweep_grid"])
     names = list(grid)
     shape = tuple(len(v) for v in grid.values())
-    coords = {name: (name, np.asarray(v, float)) for name, v in grid.items()}
+    coords: dict[str, tuple] = {name: (name, np.asarray(v, float)) for name, v in grid.items()}
     for name in ("polar", "azimuth"):
         coords[name] = (name, coords[name][1], dict(ds[name].attrs))
     data = {}
@@ -1040,6 +1107,15 @@ def plot_atlas(ds, out, *, variables=("half_period", "sensitivity"), dpi: int = 
         two non-trivial axes (select a plane first, e.g. ``ds.isel(I2=0)``).
     MissingDependencyError
         matplotlib missing (extra ``plot``).
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import load_sweep, plot_atlas, run_sweep
+    >>> cfg = {"inertia": {"I1": 1.0, "I2": 2.0, "I3": 3.0},
+    ...        "momentum": {"polar": [30.0, 60.0, 90.0], "azimuth": [0.0, 45.0]},
+    ...        "output": {"path": "sphere.zarr"}, "compute": {"T": 5.0, "scheduler": "serial"}}
+    >>> plot_atlas(load_sweep(run_sweep(cfg, progress=False)), "atlas.png", dpi=40).name
+    'atlas.png'
     """
     if not hasattr(ds, "data_vars") or "half_period" not in ds:
         raise InvalidInputError("plot_atlas needs a sweep dataset from load_sweep(path)")

@@ -1,1 +1,1 @@
-"""Small shared utilities: argument validation and the numba switch."""
+"""Small shared utilities: argument validation, the numba switch (kernels made on first use) and their warm-up."""

@@ -40,13 +40,18 @@ import os
 import re
 import shutil
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 
+from ..errors import InvalidInputError, MissingDependencyError
 from ..io.atomic import atomic_path
 from ..util.validate import as_float_array
-from ..errors import InvalidInputError, MissingDependencyError
 from .plots import AXIS_COLORS, import_matplotlib, plain_text, select_body
+
+if TYPE_CHECKING:
+    from ..io.read import LazyTrajectory
+    from ..trajectory import Trajectory
 
 __all__ = ["animate", "box_dimensions", "slerp_series", "FORMATS", "GifStreamWriter"]
 
@@ -300,7 +305,7 @@ def default_duration(span: float) -> float:
 # ---------------------------------------------------------------------------
 # public entry point
 # ---------------------------------------------------------------------------
-def animate(traj, out, *, fps=30, duration=None, index=0, size=(640, 480),
+def animate(traj: Trajectory | LazyTrajectory, out: str | os.PathLike[str], *, fps: float = 30, duration: float | None = None, index: int | tuple[int, ...] = 0, size: tuple[int, int] = (640, 480),
             max_samples: int = MAX_HTML_SAMPLES) -> Path:
     r"""Write an animation of the tumbling body: ``.html``, ``.gif`` or ``.mp4`` by the extension of ``out``.
 
@@ -692,7 +697,7 @@ class GifStreamWriter:
 
     def __init__(self, fps):
         self.fps = float(fps)
-        self._fh = None
+        self._fh: BinaryIO | None = None  # the open file, from setup() to finish()
 
     @contextlib.contextmanager
     def saving(self, fig, outfile, dpi):
@@ -711,8 +716,9 @@ class GifStreamWriter:
         fig.set_dpi(dpi)
         self._fh = open(outfile, "wb")
         self._prev = None  # the previous frame (RGB array)
-        self._pending = None  # (P image, offset, duration in ms): written when the next frame differs
-        self._size = None
+        # (P image, offset, duration in ms): written when the next frame differs
+        self._pending: tuple[Any, tuple[int, int], float] | None = None
+        self._size: tuple[int, int] | None = None
         self.frames = 0
 
     def _header(self, w, h) -> bytes:
@@ -734,6 +740,7 @@ class GifStreamWriter:
         rgb = np.ascontiguousarray(rgb, dtype=np.uint8)
         h, w = rgb.shape[:2]
         duration = 1000.0 / self.fps
+        assert self._fh is not None, "add_frame() after setup()"
         if self._size is None:
             self._size = (w, h)
             self._fh.write(self._header(w, h))
@@ -744,6 +751,7 @@ class GifStreamWriter:
             diff = np.any(rgb != self._prev, axis=2)
             rows = np.flatnonzero(diff.any(axis=1))
             if rows.size == 0:  # the same picture: show the previous frame longer
+                assert self._pending is not None  # a frame was added before
                 im, off, d = self._pending
                 self._pending = (im, off, d + duration)
                 return
@@ -761,6 +769,7 @@ class GifStreamWriter:
 
         if self._pending is None:
             return
+        assert self._fh is not None  # frames pending: the file is open
         im, off, d = self._pending
         for part in GifImagePlugin.getdata(im, offset=off, duration=int(round(d)), include_color_table=True):
             self._fh.write(part)
@@ -826,10 +835,10 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
     if mdir is not None:
         lines.append((np.zeros(3), arrow * mdir, "#111111", 2.2))
     with mpl.rc_context({"font.size": 10}):
-        fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, layout="none")
+        fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, layout="none")  # type: ignore[arg-type]  # "none" is documented
         FigureCanvasAgg(fig)
         fig.patch.set_facecolor("white")
-        ax = fig.add_axes([0.0, 0.0, 1.0, 0.9], projection="3d")
+        ax = fig.add_axes([0.0, 0.0, 1.0, 0.9], projection="3d")  # type: ignore[call-overload]  # a list is a rect
         ax.set_axis_off()
         ax.set_proj_type("ortho")
         ax.computed_zorder = False
@@ -846,7 +855,7 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
         coll = Poly3DCollection([verts[idx] for idx, *_ in faces], zorder=1, linewidths=0.6)
         ax.add_collection3d(coll)
         artists = []
-        for a, b, color, lw in lines:
+        for _a, _b, color, lw in lines:
             (ln,) = ax.plot([], [], [], color=color, lw=lw, zorder=2, solid_capstyle="butt")
             artists.append(ln)
         tip = None

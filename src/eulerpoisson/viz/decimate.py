@@ -37,7 +37,7 @@ class Piece(NamedTuple):
     cols: np.ndarray
     lo: np.ndarray
     hi: np.ndarray
-    count: np.ndarray
+    count: np.ndarray  # type: ignore[assignment]  # the field hides tuple.count, which nobody calls on a Piece
     n: int
     tmin: float
     tmax: float

@@ -96,13 +96,20 @@ import os
 import threading
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..io.atomic import atomic_path
 from ..attitude.core import matrix_from_unit_quaternion
-from ..numerics.quaternion import qmul, qmul_components
 from ..errors import InvalidInputError, require
+from ..io.atomic import atomic_path
+from ..numerics.quaternion import qmul, qmul_components
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+    from ..io.read import LazyTrajectory
+    from ..trajectory import Trajectory
 
 __all__ = [
     "KINDS",
@@ -232,7 +239,7 @@ def select_body(traj, index=0) -> _One:
                 raise InvalidInputError(
                     f"index={index!r} is out of range for a batch of {nb} bodies (batch shape {bshape})"
                 )
-            idx = np.unravel_index(int(index) % nb, bshape)
+            idx: tuple = np.unravel_index(int(index) % nb, bshape)
         elif isinstance(index, tuple) and len(index) == len(bshape) and all(
             isinstance(i, (int, np.integer)) and not isinstance(i, bool) for i in index
         ):
@@ -493,7 +500,7 @@ def _thin(traj, limit: int, *, blocks: bool = False):
     total = sum(b - a for a, b in chunks)
     step = max(1, -(-total // limit))
     # contiguous runs of the chosen chunks, read in pieces of at most _PIECE samples
-    runs = []
+    runs: list[list[int]] = []
     for a, b in chunks:
         if runs and runs[-1][1] == a:
             runs[-1][1] = b
@@ -801,7 +808,7 @@ def sphere_conic(moments, level, radius, n=1200):
     if zero.all():
         return []
     if zero.sum() == 2:
-        i, k = np.flatnonzero(zero)
+        i, k = map(int, np.flatnonzero(zero))
         return [circle(E[i], E[k])]
     if zero.sum() == 1:
         i = int(np.flatnonzero(zero)[0])
@@ -1061,7 +1068,7 @@ def _chart_bounds_compiled():
     return bounds
 
 
-_CHART_KERNEL = []
+_CHART_KERNEL: list = []
 
 
 def _chart_bounds(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
@@ -1348,7 +1355,7 @@ def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **
                 ax.annotate(f"{deg}°", (r * np.cos(np.pi / 4), r * np.sin(np.pi / 4)), color="0.45", fontsize=7.5,
                             ha="left", va="bottom", zorder=1)
         pts = np.stack([x, y], -1)
-        segs = np.stack([pts[:-1], pts[1:]], 1)
+        segs: Any = np.stack([pts[:-1], pts[1:]], 1)  # (N, 2, 2): LineCollection takes it (its stubs say a list)
         below = (h[:-1] < 0) & (h[1:] < 0)
         kw = {"linewidth": 1.1, **style}
         lc = LineCollection(segs, cmap=cmap, linestyles=[(0, (3, 2)) if b else "solid" for b in below], **kw)
@@ -1413,7 +1420,7 @@ def save_figure(fig, out, *, dpi=None) -> Path:
 
 
 
-def plot(traj, kind: str, out=None, *, index=0, dpi=None, **kwargs):
+def plot(traj: Trajectory | LazyTrajectory, kind: str, out: str | os.PathLike[str] | None = None, *, index: int | tuple[int, ...] = 0, dpi: float | None = None, **kwargs: Any) -> Figure:
     """Draw one kind of picture, and save it when ``out`` is given.
 
     Parameters

@@ -59,10 +59,13 @@ bitwise equal to :func:`motion_kernel_scalar`) and :func:`constants_kernel`
 are the two compiled entry points (one signature each); :func:`free_flow` is
 the kinetic step of the exact splitting methods.
 
-The compiled kernels are used when numba imports and the environment variable
-``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
-module, :data:`USE_NUMBA`); otherwise :mod:`eulerpoisson.solvers.exact.motion` runs its
-NumPy path (the reference).  The functions here are plain Python when numba
+The compiled kernels are used when numba is installed and the environment
+variable ``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (:data:`USE_NUMBA`, decided
+when eulerpoisson is imported, without importing numba: the dispatchers and
+intrinsics are made on the first call of a kernel and loaded from numba's
+cache, :mod:`eulerpoisson.util.jit`; ``eulerpoisson warmup`` fills the cache);
+otherwise :mod:`eulerpoisson.solvers.exact.motion` runs its NumPy path (the
+reference), which ``solve`` also runs for small problems (no numba import).  The functions here are plain Python when numba
 is not used (correct, bitwise equal, but slow; not used by the package then).
 
 References
@@ -80,6 +83,7 @@ References
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -119,8 +123,8 @@ MAX_LANDEN = 40
 _MAX_AGM = 60
 _MAX_DUPLICATION = 200
 _R_TOL = 2.0**-53
-_RF_QFAC = (3.0 * _R_TOL) ** (-1.0 / 6.0)
-_RDJ_QFAC = (0.25 * _R_TOL) ** (-1.0 / 6.0)
+_RF_QFAC: float = (3.0 * _R_TOL) ** (-1.0 / 6.0)
+_RDJ_QFAC: float = (0.25 * _R_TOL) ** (-1.0 / 6.0)
 _M1_SEPARATRIX = 1e-200
 _TWO200 = 2.0**200
 _TWOM100 = 2.0**-100
@@ -185,9 +189,9 @@ _C_HAVE_JCD = 59
 _C_HAVE_JFAR0 = 60
 _C_HAVE_T0 = 61
 _C_SQM = 62  # Landen levels sqrt(p_i) (MAX_LANDEN entries)
-_C_PCL = _C_SQM + MAX_LANDEN  # and 1 - p_i
+_C_PCL: int = _C_SQM + MAX_LANDEN  # and 1 - p_i
 #: length of the per-body constants array
-N_CONST = _C_PCL + MAX_LANDEN
+N_CONST: int = _C_PCL + MAX_LANDEN
 
 
 # =============================================================================
@@ -1216,7 +1220,6 @@ def body_eval(cst, t):
     """
     p0 = int(cst[_C_PERM0])
     p1 = int(cst[_C_PERM0 + 1])
-    p2 = int(cst[_C_PERM0 + 2])
     s1 = cst[_C_SGN0 + 1]
     if t == 0.0:
         # the initial condition is reproduced exactly
@@ -1407,10 +1410,13 @@ def constants_kernel(inertia, M0, out):
 # compilation
 # =============================================================================
 if USE_NUMBA:  # pragma: no branch
-    from llvmlite import ir as _ir
-    from numba import njit as _njit
-    from numba import types as _types
-    from numba.core.extending import intrinsic as _intrinsic
+    # made when numba is first used, not at import (util.jit: lazy_njit, activate)
+    from ...util.jit import lazy_intrinsic as _intrinsic
+    from ...util.jit import lazy_module as _lazy_module
+    from ...util.jit import lazy_njit as _njit
+
+    _ir = _lazy_module("llvmlite.ir")
+    _types = _lazy_module("numba.core.types")
 
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)
@@ -1555,6 +1561,7 @@ if USE_NUMBA:  # pragma: no branch
 # (nb, 3) and times (T,), inputs validated by the caller (finite, moments > 0, C-contiguous
 # float64): the lane kernel lanes.motion_lanes (sixteen evaluations in lockstep), whose results are
 # those of motion_kernel_scalar bit for bit. (lanes sets it too, should it be imported first.)
+motion_kernel: Callable[..., None]  # (declared for type checkers: lanes and this module import each other)
 from . import lanes as _lanes  # noqa: E402
 
 if hasattr(_lanes, "motion_lanes"):  # pragma: no branch

@@ -364,12 +364,12 @@ def _assemble(Z1, Z2, dZ1, dZ2):
     return q, om
 
 
-def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None):
+def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None, compiled=None):
     """Heavy top, ``P > 0``, in the frame where up is ``e_z``.
 
     All arrays are per body, ``(N, ...)``; ``t`` is ``(N, T)`` (scaled times).
     With ``t_scale`` (N,) and ``t_times`` (T,) given (``t = t_scale t_times``)
-    and numba in use, the motion at the output times is evaluated by the
+    and numba in use (and ``compiled`` not False), the motion at the output times is evaluated by the
     compiled kernel (:mod:`.lagrange_kernels`), which also does the last
     steps of :func:`lagrange_top_motion` (``post = (q_f, q0_in, omega0_in)``,
     per body): the returned boolean array marks those bodies. The set-up is
@@ -546,7 +546,7 @@ def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None):
     e1 = np.where(np.isfinite(e1), e1, 1.0)
     e2 = np.where(np.isfinite(e2), e2, 1.0)
 
-    if t_scale is not None and post is not None and _use_kernel():
+    if t_scale is not None and post is not None and compiled is not False and _use_kernel():
         from . import lagrange_kernels as _LK
 
         Cb = np.empty((len(i), _LK.N_LAG))
@@ -622,7 +622,7 @@ def _per_time(c, tt):
     return cc, ss, cdot, sdot, rate_c, rate_s, perS, perD
 
 
-def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t):
+def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
     r"""Closed-form motion of a Lagrange top (heavy symmetric top).
 
     Parameters
@@ -646,6 +646,10 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t):
         Initial body angular velocity.
     t : array_like (T,)
         Output times, any order, negative allowed.
+    compiled : bool or None, optional
+        None (default): the compiled evaluation at the output times when
+        numba is in use; False: NumPy (``solve`` passes it for small
+        problems, see :func:`eulerpoisson.util.jit.use_compiled`).
 
     Returns
     -------
@@ -731,7 +735,7 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t):
         q_out[i] = q
         om_out[i] = o
     if np.all(heavy):
-        q_out = om_out = None  # the heavy-top evaluation allocates them (the compiled one fills them directly)
+        q_out = om_out = None  # type: ignore[assignment]  # the heavy-top evaluation allocates them (the compiled one fills them directly)
     if np.any(heavy):
         i = np.flatnonzero(heavy)
         zhat = -np.sign(ell_[i])[:, None] * g_[i] / gn[i, None]
@@ -742,7 +746,7 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t):
         W = np.ldexp(1.0, kw.astype(int))
         q, o, final = _heavy_top(np.ldexp(A_[i], -ks.astype(int)), np.ldexp(C_[i], -ks.astype(int)),
                                  np.ldexp(P[i], (-ks - 2 * kw).astype(int)), q0f, om_[i] / W[:, None],
-                                 W[:, None] * t[None, :], W, t, (qf, q0_in[i], om_[i]))
+                                 W[:, None] * t[None, :], W, t, (qf, q0_in[i], om_[i]), compiled)
         done = np.zeros(Nb, dtype=bool)
         # the compiled kernel did the last steps below for the bodies marked final
         done[i[final]] = True

@@ -290,7 +290,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
 
 
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)

@@ -1289,7 +1289,7 @@ def _run_block(CL, TT, ON, OUT, EQ, t, j0, nl, b0, db, dj, Mout, qout):
 # compilation
 # =============================================================================
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)

@@ -91,7 +91,17 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
 
 @dataclass(frozen=True)
 class ExactOptions(MethodOptions):
-    """``method="exact"`` has no options."""
+    """``method="exact"`` has no options.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.solvers import ExactOptions
+    >>> ExactOptions().to_dict()
+    {}
+    >>> ep.solve([1.0, 2.0, 2.5], [1.0], omega0=[1.0, 0.1, 0.5], method=ExactOptions()).method
+    'exact'
+    """
 
     method = "exact"
 
@@ -112,6 +122,16 @@ class Exact(Method):
     InvalidInputError
         At times with :math:`|\boldsymbol\Omega_0||t| > 2^{48}`, where
         float64 no longer determines the phase of the motion.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.solvers.exact import Exact
+    >>> Exact.name, Exact.order
+    ('exact', None)
+    >>> tr = ep.solve([3.0, 5.0, 8.0], [0.0, 1e6], omega0=[0.0, 0.4, 0.00125])   # any time, O(1)
+    >>> print(tr.method, np.round(tr.drift()["energy"], 12))
+    exact 0.0
     """
 
     name = "exact"
@@ -126,32 +146,69 @@ class Exact(Method):
         return ("the closed form covers the free body and the Lagrange top (a symmetric body with its centre of mass "
                 f"on the symmetry axis under one Gravity torque), and the model has {model.describe()}")
 
+    #: compiled kernels or NumPy, chosen for a whole batch by :meth:`for_batch` (None: from the problem run)
+    _compiled: bool | None = None
+    #: whether the body frame is the principal frame of every body, decided for a whole batch by
+    #: :meth:`for_batch` (None: from the problem run), so that a chunk of diagonal tensors in a batch
+    #: that has full ones takes the same path as the whole batch (the same signs of zeros)
+    _principal: bool | None = None
+
+    def numpy_estimate(self, problem: Problem) -> float:
+        """Seconds of the NumPy path on one core (below ``NUMPY_BELOW``, numba is not used).
+
+        Measured (benchmarks/README.md, cold start): the free body about 2 ms per call, 8 microseconds per
+        body and 2 per (body, time); the Lagrange top about 5 ms, 20 and 2.5.
+        """
+        from ...util.jit import run_shape
+
+        # a part of a larger run (chunks of times or points): the size of the whole run decides
+        B, T = run_shape(int(np.prod(problem.batch_shape, dtype=int)), problem.t.shape[0])
+        if not problem.model.is_free:
+            return 5e-3 + 20e-6 * B + 2.5e-6 * B * T
+        return 2e-3 + 8e-6 * B + 2e-6 * B * T
+
+    def _use_compiled(self, problem: Problem) -> bool:
+        from ...util.jit import use_compiled
+
+        return self._compiled if self._compiled is not None else use_compiled(self.numpy_estimate(problem))
+
+    def for_batch(self, problem: Problem) -> Exact:
+        """This method with the batch-wide choices made: compiled kernels or NumPy (:meth:`numpy_estimate`), principal frame."""
+        import copy
+
+        planned = copy.copy(self)
+        planned._compiled = self._use_compiled(problem)
+        planned._principal = _principal_frame(problem)
+        return planned
+
     def run(self, problem: Problem) -> MethodResult:
         from .motion import exact_motion
 
         if not problem.model.is_free:
             return self._run_lagrange(problem)
+        compiled = self._use_compiled(problem)
 
         _check_phase_range(problem)
         Ip = problem.principal_moments
-        if _principal_frame(problem):
+        if self._principal if self._principal is not None else _principal_frame(problem):
             # the body frame is the principal frame of every body (a batch of moments, or diagonal
             # tensors): no rotations (three einsums and the test of the tensors cost more per body
             # than the closed form itself in the Monte-Carlo case)
             # M0 = I Omega0 with a diagonal I: the moments times Omega0 (the matrix product adds zeros)
-            Mp, q_rel = exact_motion(Ip, Ip * problem.omega0, problem.t)
+            Mp, q_rel = exact_motion(Ip, Ip * problem.omega0, problem.t, compiled=compiled)
             omega = Mp / Ip[..., None, :]
         else:
             P = problem.principal_axes  # (*B, 3, 3), det +1
             Mp0 = np.einsum("...ji,...j->...i", P, problem.M0)
-            Mp, q_rel = exact_motion(Ip, Mp0, problem.t)
+            Mp, q_rel = exact_motion(Ip, Mp0, problem.t, compiled=compiled)
             omega_p = Mp / Ip[..., None, :]
             omega = np.einsum("...ij,...tj->...ti", P, omega_p)
             qP = quaternion_from_rotation_matrix(P)[..., None, :]
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
             q_rel = qmul(qmul(qP, q_rel), qPc)
         q = compose_initial(problem, q_rel)
-        return MethodResult(q=q, omega=omega, stats={"evaluations": int(np.prod(q.shape[:-1]))})
+        return MethodResult(q=q, omega=omega, stats={"evaluations": int(np.prod(q.shape[:-1])),
+                                                     "compiled": bool(compiled and _numba_in_use())})
 
     def work_estimate(self, problem: Problem) -> float:
         """Seconds on one core (decides whether threads pay off): the measured costs of the lane kernel.
@@ -174,17 +231,25 @@ class Exact(Method):
         rate = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1)) + np.sqrt(
             mass * np.sqrt(np.sum(g * g, axis=-1)) * np.abs(ell) / A)
         _check_phase_range(problem, rate)
+        compiled = self._use_compiled(problem)
         if np.all(F.reshape(-1, 9) == np.eye(3).reshape(9)):
             # the symmetry axis is the third body axis already: no change of frame
-            q, w = lagrange_top_motion(A, C, mass, ell, g, problem.q0, problem.omega0, problem.t)
+            q, w = lagrange_top_motion(A, C, mass, ell, g, problem.q0, problem.omega0, problem.t, compiled=compiled)
         else:
             qF = quaternion_from_rotation_matrix(F)
             q0 = qmul(problem.q0, qF)
             w0 = np.einsum("...ji,...j->...i", F, problem.omega0)
-            q, w = lagrange_top_motion(A, C, mass, ell, g, q0, w0, problem.t)
+            q, w = lagrange_top_motion(A, C, mass, ell, g, q0, w0, problem.t, compiled=compiled)
             q = qmul(q, (qF * np.array([1.0, -1.0, -1.0, -1.0]))[..., None, :])
             w = np.einsum("...ij,...tj->...ti", F, w)
-        return MethodResult(q=q, omega=w, stats={"evaluations": int(np.prod(q.shape[:-1])), "model": "lagrange top"})
+        return MethodResult(q=q, omega=w, stats={"evaluations": int(np.prod(q.shape[:-1])), "model": "lagrange top",
+                                                 "compiled": bool(compiled and _numba_in_use())})
+
+
+def _numba_in_use() -> bool:
+    from ...util.jit import USE_NUMBA
+
+    return USE_NUMBA
 
 
 def _principal_frame(problem: Problem) -> bool:
@@ -197,19 +262,12 @@ def _principal_frame(problem: Problem) -> bool:
 
 
 def _lagrange_parameters(model):
-    """``(A, C, mass, ell, g, F)`` of a (batch of) Lagrange top(s), each with the model's batch shape, or None."""
-    shape = model.batch_shape
-    rows = []
-    for idx in np.ndindex(*shape) if shape else [()]:
-        lt = (model.element(idx) if shape else model).lagrange_top()
-        if lt is None:
-            return None
-        rows.append(lt)
-    if not shape:
-        lt = rows[0]
-        return lt.A, lt.C, lt.mass, lt.ell, lt.g, lt.frame
+    """``(A, C, mass, ell, g, F)`` of a (batch of) Lagrange top(s), each with the model's batch shape, or None.
 
-    def stack(k, tail):
-        return np.array([np.asarray(r[k], dtype=float) for r in rows]).reshape(shape + tail)
-
-    return stack(0, ()), stack(1, ()), stack(2, ()), stack(3, ()), stack(4, (3,)), stack(5, (3, 3))
+    One vectorized call of :meth:`~eulerpoisson.model.equations.Model.lagrange_top` for the whole batch
+    (no loop over the bodies in Python).
+    """
+    lt = model.lagrange_top()
+    if lt is None:
+        return None
+    return lt.A, lt.C, lt.mass, lt.ell, lt.g, lt.frame

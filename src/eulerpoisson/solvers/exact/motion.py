@@ -129,6 +129,9 @@ the lane kernel of :mod:`eulerpoisson.solvers.exact.lanes`, sixteen
 evaluations in lockstep): the same floating-point operations in the same
 order, with O(1) memory per body, bitwise equal to this module where both use
 the C library's elementary functions (to a few ulp otherwise).
+``solve(..., method="exact")`` runs this module's NumPy path for small
+problems (about 2*10^4 evaluations or fewer: ``compiled=False``), which it
+solves faster than numba is imported and the kernel loaded from its cache.
 
 References
 ----------
@@ -147,10 +150,10 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ...errors import InvalidInertiaError, InvalidInputError
 from ...numerics import elliptic as _el
 from ...numerics.doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, two_prod, two_sum
 from ...numerics.quaternion import qmul_components
-from ...errors import InvalidInertiaError, InvalidInputError
 
 __all__ = [
     "ExactMotion",
@@ -317,6 +320,37 @@ class _Body:
         "rate", "coef", "nu", "omnu", "Jc", "Nadd", "Cadd", "nud", "omnud", "Jcd",
         "g0", "Gc", "sn0", "sep", "caseB", "Jfar0", "theta0", "kfull", "P", "q0",
     )
+    regime: np.ndarray
+    m: np.ndarray
+    m1: np.ndarray
+    lam: np.ndarray
+    t0h: np.ndarray
+    t0l: np.ndarray
+    Ac: np.ndarray
+    A2: np.ndarray
+    Aa: np.ndarray
+    sa: np.ndarray
+    sc: np.ndarray
+    rate: np.ndarray
+    coef: np.ndarray
+    nu: np.ndarray
+    omnu: np.ndarray
+    Jc: np.ndarray
+    Nadd: np.ndarray
+    Cadd: np.ndarray
+    nud: np.ndarray
+    omnud: np.ndarray
+    Jcd: np.ndarray
+    g0: np.ndarray
+    Gc: np.ndarray
+    sn0: np.ndarray
+    sep: np.ndarray
+    caseB: np.ndarray
+    Jfar0: np.ndarray
+    theta0: np.ndarray
+    kfull: np.ndarray
+    P: _el.JacobiParams
+    q0: tuple[np.ndarray, ...]  # the quaternion's components
 
 
 def _dd_square_times(x, dh, dl, y):
@@ -686,7 +720,7 @@ def _prepare(inertia, M0):
     return inertia, M0, batch, perm, sgn, eM, escale, eq, B
 
 
-def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK):
+def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
     r"""Closed-form free rigid-body motion in the principal frame.
 
     Evaluates, for every body of the batch and every time, the exact solution
@@ -712,6 +746,12 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK):
         Times, any order and sign.
     chunk_size : int, optional
         Number of (body, time) pairs evaluated at once (memory bound only).
+    compiled : bool or None, optional
+        None (default): the compiled kernel when numba is in use, else
+        NumPy; False: the NumPy path; True: the compiled kernel where numba
+        is in use (NumPy otherwise). ``solve(..., method="exact")`` passes
+        False for small problems, which NumPy solves faster than numba is
+        imported (:func:`eulerpoisson.util.jit.use_compiled`).
 
     Returns
     -------
@@ -755,7 +795,9 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK):
     microseconds for a body evaluated at a single time (set-up included;
     benchmarks/bench_exact.py); memory O(1) per body (``chunk_size`` is then
     irrelevant).  The first call in a fresh environment compiles the kernels
-    (about 20 s, cached on disk).  Without numba, or with the environment
+    (about 20 s, cached on disk: ``eulerpoisson warmup``); the first call in
+    a process imports numba and loads them from the cache (about 0.5 s).
+    Without numba, or with the environment
     variable ``EULERPOISSON_NO_NUMBA=1``, the vectorized NumPy path runs (the
     reference; about 1 microsecond per (body, time) plus ~4 microseconds per
     body, and ~2 ms of overhead per call).  Both paths perform the same
@@ -774,9 +816,9 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK):
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise InvalidInputError(f"chunk_size must be a positive integer, got {chunk_size}")
-    from . import kernels as _K
+    from ...util.jit import USE_NUMBA  # (the kernels module is imported by the compiled path only)
 
-    if _K.USE_NUMBA:
+    if USE_NUMBA and compiled is not False:
         return _exact_motion_compiled(inertia, M0, t)
     return _exact_motion_numpy(inertia, M0, t, chunk_size)
 

@@ -37,19 +37,18 @@ Equations I*, 2nd ed. (1993), II.5 (DOP853).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import ClassVar
-
-import math
 
 import numpy as np
 
 from ...errors import EulerPoissonError, InvalidInputError
 from ...model.free_body import euler_coefficients
 from ...numerics.quaternion import qmul_components
+from .. import charts as ch
 from ..problem import Problem
 from ..registry import Method, MethodOptions, MethodResult, register_method
-from .. import charts as ch
 
 __all__ = ["RK", "INTEGRATORS"]
 
@@ -105,7 +104,19 @@ _NFEV_PER_STEP = 16
 
 @dataclass(frozen=True)
 class RKOptions(MethodOptions):
-    """Options of ``method="rk"`` (scipy's ``solve_ivp``); see :class:`RK` for their meaning."""
+    """Options of ``method="rk"`` (scipy's ``solve_ivp``); see :class:`RK` for their meaning.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.solvers import RKOptions
+    >>> opts = RKOptions(integrator="RK45", tol=1e-9)
+    >>> opts.integrator, opts.tol
+    ('RK45', 1e-09)
+    >>> tr = ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.1, 0.5], method=opts)
+    >>> tr.method, bool(tr.drift()["energy"] < 1e-7)
+    ('rk', True)
+    """
 
     method: ClassVar[str] = "rk"
 
@@ -154,8 +165,8 @@ class RKOptions(MethodOptions):
 class RK(Method):
     r"""``scipy.integrate.solve_ivp`` on the quaternion or Gibbs-vector formulation.
 
-    Options
-    -------
+    Parameters
+    ----------
     integrator : str
         A ``solve_ivp`` method: ``"DOP853"`` (default), ``"RK45"``,
         ``"RK23"``, ``"Radau"``, ``"BDF"`` or ``"LSODA"``.
@@ -183,6 +194,17 @@ class RK(Method):
     threads (``threads = False``), since ``solve_ivp`` steps in Python and
     holds the GIL (threads would only add overhead); use processes (e.g.
     ``eulerpoisson sweep``) to spread many bodies over cores.
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.solvers.rk import RK
+    >>> RK.name, RK.refine
+    ('rk', 'tol')
+    >>> tr = ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.1, 0.5], method="rk", tol=1e-12)
+    >>> ref = ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.1, 0.5])
+    >>> bool(np.max(np.abs(tr.omega - ref.omega)) < 1e-9)
+    True
     """
 
     name = "rk"
@@ -331,8 +353,8 @@ class RK(Method):
         def event(t, y):
             return y[0] * y[0] + y[1] * y[1] + y[2] * y[2] - thr2
 
-        event.terminal = True
-        event.direction = 1.0
+        event.terminal = True  # type: ignore[attr-defined]  # scipy's solve_ivp reads these attributes
+        event.direction = 1.0  # type: ignore[attr-defined]
 
         order = np.argsort(np.abs(times), kind="stable")
         ts = times[order]

@@ -140,7 +140,7 @@ def split_body(D, q0, M0, tau0, S, L, nu, kappa, times, dt, c, d, qout, Mout, cs
 
 
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
     _torque = _njit(cache=True, nogil=True)(_torque)
     split_body = _njit(cache=True, nogil=True)(split_body)

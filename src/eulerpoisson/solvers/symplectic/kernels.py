@@ -52,9 +52,11 @@ Same results as NumPy
     in both), so the results agree bit for bit on the same machine (tested
     with ``EULERPOISSON_NO_NUMBA=1`` in a subprocess).
 
-The kernels are used when numba imports and the environment variable
-``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
-module, as for the ``taylor`` kernels); :data:`USE_NUMBA` says which.
+The kernels are used when numba is installed and the environment variable
+``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (decided when eulerpoisson is
+imported, without importing numba: the kernels are made on their first call,
+:mod:`eulerpoisson.util.jit`, as for the ``taylor`` kernels); :data:`USE_NUMBA`
+says which.
 
 References
 ----------
@@ -626,7 +628,7 @@ def _nb_gauss(y0, inv_m, A, b, E, max_iter, seg_h, seg_n, seg_out, seg_restart, 
 
 
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
     _inline = _njit(inline="always", cache=True, nogil=True)
     _plain = _njit(cache=True, nogil=True)

@@ -14,9 +14,11 @@ Two implementations of the same algorithm live here:
   chosen in float64 in every arithmetic (a float64 step is exact in the
   others).
 
-The compiled kernels are used when numba imports and the environment variable
-``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (checked once, at import of this
-module); otherwise the NumPy path runs. Both take the same steps and give the
+The compiled kernels are used when numba is installed and the environment
+variable ``EULERPOISSON_NO_NUMBA`` is not ``"1"`` (:data:`USE_NUMBA`, decided
+when eulerpoisson is imported, without importing numba: the kernels are made
+and loaded from numba's cache on their first call, see
+:mod:`eulerpoisson.util.jit`); otherwise the NumPy path runs. Both take the same steps and give the
 same results to round-off: the compiled kernels let LLVM fuse multiply-adds
 (``fastmath={"contract"}`` only, no reassociation) and sum the Cauchy
 products in a different order.
@@ -75,6 +77,11 @@ import math
 
 import numpy as np
 
+from ...model.free_body import euler_coefficients
+from ...numerics.doubledouble import two_sum
+from ...numerics.quaternion import qmul_components
+from ...util.jit import USE_NUMBA, stack_buffer  # USE_NUMBA: numba importable, EULERPOISSON_NO_NUMBA not "1"
+
 __all__ = [
     "USE_NUMBA",
     "STATUS_OK",
@@ -94,13 +101,6 @@ __all__ = [
 STATUS_OK = 0
 STATUS_MAX_STEPS = 1
 STATUS_NONFINITE = 2
-
-
-from ...model.free_body import euler_coefficients
-from ...numerics.doubledouble import two_sum
-from ...numerics.quaternion import qmul_components
-from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
-from ...util.jit import stack_buffer
 
 
 def auto_order(tol: float) -> int:
@@ -650,7 +650,6 @@ def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_s
     dn = np.zeros(3)
     dw = np.zeros(3)
     qr = np.zeros(4)
-    qtmp = np.zeros(4)
     nv = np.zeros(3)
     wv = np.zeros(3)
     if order > 1:
@@ -1166,7 +1165,7 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
 
 
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
     _nb_mul = _njit(cache=True, nogil=True)(_nb_mul)  # no fastmath flags: never contracted
     _nb_series = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series)

@@ -185,6 +185,90 @@ def _coefficients(order, Q, W, V, Z, Rr, MI, I, Iinv, tau0, L, nv, nu, kappa, or
             Rr[k + 1, 2] = d2 * inv
 
 
+def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
+    r"""The Taylor coefficients 1..order for one Poisson vector and no orbit (gravity: the heavy top).
+
+    :math:`\dot{\boldsymbol\Omega} = I^{-1}\big((I\boldsymbol\Omega)\times\boldsymbol\Omega
+    + \boldsymbol\tau_0\big) + M\mathbf v` with :math:`M = I^{-1}L` (made once per body),
+    :math:`\dot{\mathbf v} = \mathbf v\times\boldsymbol\Omega`,
+    :math:`\dot q = \frac12 q\otimes(0, \boldsymbol\Omega)`: :func:`_coefficients` without its
+    branches and its loops over Poisson vectors. Each order runs the closed (Omega, v) recurrence
+    first (the critical path: the next order needs it) and the q sums after (independent work that
+    overlaps it); 1/(k + 1) is multiplied, not divided. Row 0 of Q, W and V (one vector: shape
+    (order + 1, 3)) is set.
+    """
+    for k in range(order):
+        # M_k = I W_k
+        x0 = W[k, 0]
+        x1 = W[k, 1]
+        x2 = W[k, 2]
+        MI[k, 0] = I[0, 0] * x0 + I[0, 1] * x1 + I[0, 2] * x2
+        MI[k, 1] = I[1, 0] * x0 + I[1, 1] * x1 + I[1, 2] * x2
+        MI[k, 2] = I[2, 0] * x0 + I[2, 1] * x1 + I[2, 2] * x2
+        # (I Omega) x Omega and v x Omega
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        c0 = 0.0
+        c1 = 0.0
+        c2 = 0.0
+        for j in range(k + 1):
+            m = k - j
+            w0 = W[m, 0]
+            w1 = W[m, 1]
+            w2 = W[m, 2]
+            m0 = MI[j, 0]
+            m1 = MI[j, 1]
+            m2 = MI[j, 2]
+            g0 += m1 * w2 - m2 * w1
+            g1 += m2 * w0 - m0 * w2
+            g2 += m0 * w1 - m1 * w0
+            v0 = V[j, 0]
+            v1 = V[j, 1]
+            v2 = V[j, 2]
+            c0 += v1 * w2 - v2 * w1
+            c1 += v2 * w0 - v0 * w2
+            c2 += v0 * w1 - v1 * w0
+        if k == 0:
+            g0 += tau0[0]
+            g1 += tau0[1]
+            g2 += tau0[2]
+        inv = 1.0 / (k + 1)
+        v0 = V[k, 0]
+        v1 = V[k, 1]
+        v2 = V[k, 2]
+        for a in range(3):
+            W[k + 1, a] = (
+                (Iinv[a, 0] * g0 + Iinv[a, 1] * g1 + Iinv[a, 2] * g2) + (ML[a, 0] * v0 + ML[a, 1] * v1 + ML[a, 2] * v2)
+            ) * inv
+        V[k + 1, 0] = c0 * inv
+        V[k + 1, 1] = c1 * inv
+        V[k + 1, 2] = c2 * inv
+        # q (x) (0, Omega): four dot products
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        s3 = 0.0
+        for j in range(k + 1):
+            m = k - j
+            w0 = W[m, 0]
+            w1 = W[m, 1]
+            w2 = W[m, 2]
+            pw = Q[j, 0]
+            px = Q[j, 1]
+            py = Q[j, 2]
+            pz = Q[j, 3]
+            s0 += -px * w0 - py * w1 - pz * w2
+            s1 += pw * w0 + py * w2 - pz * w1
+            s2 += pw * w1 - px * w2 + pz * w0
+            s3 += pw * w2 + px * w1 - py * w0
+        hinv = 0.5 * inv
+        Q[k + 1, 0] = s0 * hinv
+        Q[k + 1, 1] = s1 * hinv
+        Q[k + 1, 2] = s2 * hinv
+        Q[k + 1, 3] = s3 * hinv
+
+
 def _norm_inf(X, k, n):
     m = 0.0
     for a in range(n):
@@ -194,22 +278,47 @@ def _norm_inf(X, k, n):
     return m
 
 
-def _horner(X, order, n, theta, out):
-    """out[a] = sum_{k>=1} X[k, a] theta^k (the increment, without the constant term)."""
-    for a in range(n):
-        acc = X[order, a]
-        for k in range(order - 1, 0, -1):
-            acc = acc * theta + X[k, a]
-        out[a] = acc * theta
+def _horner(Q, W, order, theta, dq, dw):
+    """dq[a] = sum_{k>=1} Q[k, a] theta^k and dw from W (the increments, without the constant terms).
+
+    The seven Horner chains run interleaved (independent: their latencies overlap).
+    """
+    a0 = Q[order, 0]
+    a1 = Q[order, 1]
+    a2 = Q[order, 2]
+    a3 = Q[order, 3]
+    b0 = W[order, 0]
+    b1 = W[order, 1]
+    b2 = W[order, 2]
+    for k in range(order - 1, 0, -1):
+        a0 = a0 * theta + Q[k, 0]
+        a1 = a1 * theta + Q[k, 1]
+        a2 = a2 * theta + Q[k, 2]
+        a3 = a3 * theta + Q[k, 3]
+        b0 = b0 * theta + W[k, 0]
+        b1 = b1 * theta + W[k, 1]
+        b2 = b2 * theta + W[k, 2]
+    dq[0] = a0 * theta
+    dq[1] = a1 * theta
+    dq[2] = a2 * theta
+    dq[3] = a3 * theta
+    dw[0] = b0 * theta
+    dw[1] = b1 * theta
+    dw[2] = b2 * theta
 
 
 def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt, max_steps, qout, wout):
     """Integrate one body from t = 0 to the output times (all of one sign, sorted by |t| ascending).
 
     Returns ``(steps, status)``: status 0 ok, 1 ``max_steps`` exhausted, 2 non-finite state.
+
+    One Poisson vector and no orbit term (gravity, or a space torque, with or without a constant
+    body torque) take :func:`_coefficients_top`.
     """
     nv = S.shape[0]
     orbit = kappa != 0.0
+    top = nv == 1 and not orbit
+    Vt = np.zeros((order + 1, 3))
     Q = np.zeros((order + 1, 4))
     W = np.zeros((order + 1, 3))
     MI = np.zeros((order + 1, 3))
@@ -235,6 +344,12 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
         j += 1
     if j >= T:
         return 0, 0
+    # the specialized kernel: ML = I^-1 L
+    ML = np.zeros((3, 3))
+    if top:
+        for a in range(3):
+            for c in range(3):
+                ML[a, c] = Iinv[a, 0] * L[0, 0, c] + Iinv[a, 1] * L[0, 1, c] + Iinv[a, 2] * L[0, 2, c]
     sgn = 1.0 if times[T - 1] > 0 else -1.0
     safety = math.exp(-0.7 / (order - 1)) if order > 1 else 0.5
     steps = 0
@@ -250,11 +365,17 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
         ux = q[1] / nq
         uy = q[2] / nq
         uz = q[3] / nq
-        for i in range(nv):
-            a0, a1, a2 = rotate_inverse(uw, ux, uy, uz, S[i, 0], S[i, 1], S[i, 2])
-            V[0, i, 0] = a0
-            V[0, i, 1] = a1
-            V[0, i, 2] = a2
+        if top:
+            a0, a1, a2 = rotate_inverse(uw, ux, uy, uz, S[0, 0], S[0, 1], S[0, 2])
+            Vt[0, 0] = a0
+            Vt[0, 1] = a1
+            Vt[0, 2] = a2
+        else:
+            for i in range(nv):
+                a0, a1, a2 = rotate_inverse(uw, ux, uy, uz, S[i, 0], S[i, 1], S[i, 2])
+                V[0, i, 0] = a0
+                V[0, i, 1] = a1
+                V[0, i, 2] = a2
         if orbit:
             a0, a1, a2 = rotate_inverse(uw, ux, uy, uz, 0.0, 0.0, 1.0)
             Z[0, 0] = a0
@@ -265,7 +386,10 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
             Rr[0, 0] = a0
             Rr[0, 1] = a1
             Rr[0, 2] = a2
-        _coefficients(order, Q, W, V, Z, Rr, MI, I, Iinv, tau0, L, nv, nu, kappa, orbit)
+        if top:
+            _coefficients_top(order, Q, W, Vt, MI, I, Iinv, ML, tau0)
+        else:
+            _coefficients(order, Q, W, V, Z, Rr, MI, I, Iinv, tau0, L, nv, nu, kappa, orbit)
         if dt > 0.0:
             h = dt
         else:
@@ -274,12 +398,15 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
             for k in (order - 1, order):
                 if k < 1:
                     continue
+                x = math.inf  # the smaller bound of the two groups, then one root
                 nqk = _norm_inf(Q, k, 4)
                 if nqk > 0.0:
-                    h = min(h, (tol / nqk) ** (1.0 / k))
+                    x = tol / nqk
                 nwk = _norm_inf(W, k, 3)
                 if nwk > 0.0 and sw > 0.0:
-                    h = min(h, (tol * sw / nwk) ** (1.0 / k))
+                    x = min(x, tol * sw / nwk)
+                if x < math.inf:
+                    h = min(h, x ** (1.0 / k))
             h = safety * h
             if not (h < math.inf):
                 # no motion at all (at rest, no torque): jump to the last output
@@ -290,8 +417,7 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
             theta = (times[j] - th) - tl
             if sgn * theta > sgn * h:
                 break
-            _horner(Q, order, 4, theta, dq)
-            _horner(W, order, 3, theta, dw)
+            _horner(Q, W, order, theta, dq, dw)
             nrm = 0.0
             for a in range(4):
                 qa = q[a] + (dq[a] + qlo[a])
@@ -306,8 +432,7 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
         if j >= T:
             steps += 1
             break
-        _horner(Q, order, 4, h, dq)
-        _horner(W, order, 3, h, dw)
+        _horner(Q, W, order, h, dq, dw)
         for a in range(4):
             s, e = two_sum(q[a], dq[a] + qlo[a])
             q[a] = s
@@ -332,12 +457,16 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
 
 
 if USE_NUMBA:  # pragma: no branch
-    from numba import njit as _njit
+    from ...util.jit import lazy_njit as _njit  # made when numba is first used, not at import
 
-    _coefficients = _njit(cache=True, nogil=True)(_coefficients)
+    # fastmath={"contract"} only (multiply-adds fused, no reassociation), as the free body's kernels: the
+    # Cauchy sums issue half the instructions (the compensated updates are two_sum, additions only, which
+    # contraction leaves exact); the interpreted twin agrees to round-off, not bit for bit
+    _coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_coefficients)
+    _coefficients_top = _njit(cache=True, nogil=True, fastmath={"contract"})(_coefficients_top)
     _norm_inf = _njit(cache=True, nogil=True)(_norm_inf)
-    _horner = _njit(cache=True, nogil=True)(_horner)
-    integrate_body = _njit(cache=True, nogil=True)(integrate_body)
+    _horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_horner)
+    integrate_body = _njit(cache=True, nogil=True, fastmath={"contract"})(integrate_body)
 
 
 def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps):

@@ -1,0 +1,160 @@
+"""Cold and warm starts of the command line (issue 15): whole processes, end to end.
+
+Every row is the wall time of a new process (``subprocess``, ``time.perf_counter`` around it),
+the best of several, in a temporary folder:
+
+* ``import_eulerpoisson``: ``python -c "import eulerpoisson"``;
+* ``cli_simulate_warm``: ``eulerpoisson simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 10
+  --samples 1001 --out x.nc`` (the issue's command: a small problem, solved by NumPy without
+  importing numba) with numba's default cache;
+* ``cli_simulate_warm_nopyc``: the same with ``PYTHONDONTWRITEBYTECODE=1`` and no ``.pyc`` files of
+  eulerpoisson (a copy of the package without them first on ``PYTHONPATH``: its modules are compiled
+  from source at every start, as in a source tree where writing bytecode is disabled; not what an
+  installed package does);
+* with a fresh, empty ``NUMBA_CACHE_DIR``: ``warmup_fresh_cache``, the time of ``eulerpoisson
+  warmup`` filling it (every kernel compiled; measured once), then in new processes the first
+  ``simulate`` of the small problem (``cli_first_simulate_after_warmup``) and of a large one that
+  runs the compiled kernel, 2*10^5 samples (``cli_first_compiled_simulate_after_warmup``: numba
+  imported and the kernel loaded from the cache).
+
+The subprocesses see the package as installed: ``.pyc`` files written and used (the default of
+Python; ``pip install`` compiles them), except in the ``_nopyc`` row. ``EULERPOISSON_WORKERS=1``.
+The goals: warm ``simulate`` <= 0.5 s; the first ``simulate`` after the warm-up <= 3 s.
+``--quick`` measures one run of each small command, skips the warm-up and the compiled row.
+
+    .venv/bin/python benchmarks/run.py --only cold_start [--quick]
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+EXE = str(Path(sys.executable).with_name("eulerpoisson"))
+SMALL = [
+    "simulate",
+    "--inertia",
+    "1,2,3",
+    "--omega",
+    "1,0.1,0.5",
+    "--t-end",
+    "10",
+    "--samples",
+    "1001",
+    "--out",
+    "x.nc",
+    "--overwrite",
+    "--quiet",
+]
+LARGE = [
+    "simulate",
+    "--inertia",
+    "1,2,3",
+    "--omega",
+    "1,0.1,0.5",
+    "--t-end",
+    "1000",
+    "--samples",
+    "200000",
+    "--out",
+    "y.nc",
+    "--overwrite",
+    "--quiet",
+]
+
+
+def _env(**extra):
+    env = dict(os.environ, EULERPOISSON_WORKERS="1", **extra)
+    env.pop("EULERPOISSON_NUMPY_BELOW", None)  # the default: small problems without numba (run.py sets it to 0)
+    if "PYTHONDONTWRITEBYTECODE" not in extra:
+        env.pop("PYTHONDONTWRITEBYTECODE", None)  # as installed: .pyc files written once and used
+    return env
+
+
+def _once(argv, cwd, env) -> float:
+    t0 = time.perf_counter()
+    res = subprocess.run(argv, cwd=cwd, env=env, capture_output=True, text=True, timeout=900)
+    wall = time.perf_counter() - t0
+    if res.returncode != 0:
+        raise RuntimeError(f"{' '.join(argv)} failed ({res.returncode}): {res.stderr[-2000:]}")
+    return wall
+
+
+def _best(argv, cwd, env, repeats) -> tuple[float, int]:
+    times = [_once(argv, cwd, env) for _ in range(repeats)]
+    return min(times), len(times)
+
+
+def run(quick: bool = False, log=print) -> dict:
+    repeats = 1 if quick else 7
+    out = {
+        "config": {
+            "small": " ".join(["eulerpoisson", *SMALL]),
+            "large": " ".join(["eulerpoisson", *LARGE]),
+            "repeats": repeats,
+        },
+        "rows": [],
+    }
+
+    def add(name, label, value, unit="s", **extra):
+        out["rows"].append({"name": name, "label": label, "value": value, "unit": unit, **extra})
+        log(f"  {label:72s} {value:8.3f} {unit}")
+
+    with tempfile.TemporaryDirectory(prefix="ep_cold_") as tmp:
+        tmp = Path(tmp)
+        env = _env()
+        # warm the .pyc files and numba's default cache for the small problem first (not timed)
+        _once([EXE, *SMALL], tmp, env)
+        wall, n = _best([sys.executable, "-c", "import eulerpoisson"], tmp, env, repeats)
+        add("import_eulerpoisson", "python -c 'import eulerpoisson' (new process)", wall, runs=n)
+        wall, n = _best([EXE, *SMALL], tmp, env, repeats)
+        add("cli_simulate_warm", "eulerpoisson simulate, 1001 samples to t = 10, --out x.nc (warm)", wall, runs=n)
+        import eulerpoisson
+
+        copy = tmp / "nopyc" / "eulerpoisson"
+        shutil.copytree(Path(eulerpoisson.__file__).parent, copy, ignore=shutil.ignore_patterns("__pycache__"))
+        nopyc = _env(PYTHONDONTWRITEBYTECODE="1", PYTHONPATH=str(copy.parent))
+        wall, n = _best([EXE, *SMALL], tmp, nopyc, max(1, repeats // 2))
+        add(
+            "cli_simulate_warm_nopyc",
+            "the same without .pyc files of eulerpoisson (compiled at every start)",
+            wall,
+            runs=n,
+        )
+
+        cache = tmp / "numba_cache"
+        cache.mkdir()
+        fresh = _env(NUMBA_CACHE_DIR=str(cache))
+        if not quick:
+            wall = _once([EXE, "warmup"], tmp, fresh)
+            add(
+                "warmup_fresh_cache",
+                "eulerpoisson warmup into an empty NUMBA_CACHE_DIR (compiles every kernel)",
+                wall,
+                runs=1,
+            )
+        what = "after eulerpoisson warmup" if not quick else "empty NUMBA_CACHE_DIR, no warm-up (quick)"
+        wall, n = _best([EXE, *SMALL], tmp, fresh, repeats)
+        add("cli_first_simulate_after_warmup", f"first simulate of 1001 samples in a new process, {what}", wall, runs=n)
+        if not quick:
+            wall, n = _best([EXE, *LARGE], tmp, fresh, max(1, repeats // 2))
+            add(
+                "cli_first_compiled_simulate_after_warmup",
+                f"first simulate of 2e5 samples (compiled kernel) in a new process, {what}",
+                wall,
+                runs=n,
+            )
+        shutil.rmtree(cache, ignore_errors=True)
+    return out
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import runpy
+
+    sys.argv = [sys.argv[0], "--only", "cold_start", *sys.argv[1:]]
+    runpy.run_path(str(Path(__file__).with_name("run.py")), run_name="__main__")

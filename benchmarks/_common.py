@@ -191,15 +191,17 @@ def scipy_rhs(inertia=INERTIA):
 
     def f(t, y):
         w, x, yy, z, o1, o2, o3 = y
-        return np.array([
-            -0.5 * (x * o1 + yy * o2 + z * o3),
-            0.5 * (w * o1 + yy * o3 - z * o2),
-            0.5 * (w * o2 - x * o3 + z * o1),
-            0.5 * (w * o3 + x * o2 - yy * o1),
-            a1 * o2 * o3,
-            a2 * o3 * o1,
-            a3 * o1 * o2,
-        ])
+        return np.array(
+            [
+                -0.5 * (x * o1 + yy * o2 + z * o3),
+                0.5 * (w * o1 + yy * o3 - z * o2),
+                0.5 * (w * o2 - x * o3 + z * o1),
+                0.5 * (w * o3 + x * o2 - yy * o1),
+                a1 * o2 * o3,
+                a2 * o3 * o1,
+                a3 * o1 * o2,
+            ]
+        )
 
     return f
 
@@ -303,7 +305,7 @@ def heyoka_batch_throughput(hy, omega0, t_end: float, *, tol: float = EPS):
             st = ta.state
             st[:4] = 0.0
             st[0] = 1.0
-            st[4:] = omega0[b0:b0 + bs].T
+            st[4:] = omega0[b0 : b0 + bs].T
             ta.propagate_until(float(t_end))
         return ta.state.copy()
 
@@ -338,10 +340,11 @@ def heyoka_ensemble(hy, omega0, t_end: float, workers: int, *, tol: float = EPS,
         st = tb.state
         st[:4] = 0.0
         st[0] = 1.0
-        st[4:] = omega0[g * bs:(g + 1) * bs].T
+        st[4:] = omega0[g * bs : (g + 1) * bs].T
         return tb
 
     if not per_thread:
+
         def run():
             res = hy.ensemble_propagate_until_batch(ta, float(t_end), groups, reset, max_workers=workers)
             return [r[0].state.copy() for r in res]
@@ -404,8 +407,11 @@ def taylor_longdouble_reference(t_end: float):
 
     ld = np.longdouble
     q, om, _ = integrate_principal(
-        np.array(INERTIA, dtype=ld), np.array(OMEGA0, dtype=ld), np.array([t_end], dtype=ld),
-        tol=ld(2e-19), backend="numpy",
+        np.array(INERTIA, dtype=ld),
+        np.array(OMEGA0, dtype=ld),
+        np.array([t_end], dtype=ld),
+        tol=ld(2e-19),
+        backend="numpy",
     )
     return q[0], om[0], "eulerpoisson Taylor integrator in 80-bit long double (tol = 2e-19, numpy backend)"
 
@@ -463,8 +469,13 @@ class MujocoPeer:
 
 def pin_single_thread() -> None:
     """Ask every threaded library for one thread (before numpy/numba are imported)."""
-    for var in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS",
-                "VECLIB_MAXIMUM_THREADS"):
+    for var in (
+        "OMP_NUM_THREADS",
+        "MKL_NUM_THREADS",
+        "OPENBLAS_NUM_THREADS",
+        "NUMBA_NUM_THREADS",
+        "VECLIB_MAXIMUM_THREADS",
+    ):
         os.environ.setdefault(var, "1")
 
 

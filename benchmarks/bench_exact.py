@@ -75,8 +75,12 @@ def counts(nb: int, T: int) -> dict:
     L = LN.LANES
     wrap(LN, "_rj_jobs", "R_J", lambda X, Y, Z, P, R, n: n)
     wrap(K, "_rj3", "R_J", lambda *a: int(bool(a[4])) + int(bool(a[9])) + int(bool(a[14])))
-    wrap(LN, "_jacobi_lanes", "Jacobi arguments",
-         lambda CL, UH, UL, ON, ng, nl, O: int(sum(ON[g * L + l] != 0.0 for g in range(ng) for l in range(nl))))
+    wrap(
+        LN,
+        "_jacobi_lanes",
+        "Jacobi arguments",
+        lambda CL, UH, UL, ON, ng, nl, O: int(sum(ON[g * L + l] != 0.0 for g in range(ng) for l in range(nl))),
+    )
     wrap(K, "_sncndn3", "Jacobi arguments", lambda k, *a: k)
     wrap(K, "_rf_poly", "R_F")
     wrap(K, "_dd_div_f", "K(m) (AGM in double-double)")
@@ -86,9 +90,11 @@ def counts(nb: int, T: int) -> dict:
         def __getattr__(self, name):
             f = getattr(math, name)
             if name in ("atan2", "sin", "cos", "sinh", "cosh", "atan", "log1p", "hypot", "asinh", "tanh", "exp"):
+
                 def g(*a):
                     c[f"libm {name}"] += 1
                     return f(*a)
+
                 return g
             return f
 
@@ -108,8 +114,14 @@ def counts(nb: int, T: int) -> dict:
 
 def _counts_subprocess(nb: int, T: int) -> dict:
     env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
-    out = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--counts", str(nb), str(T)],
-                         capture_output=True, text=True, env=env, timeout=1800, cwd=str(HERE))
+    out = subprocess.run(
+        [sys.executable, str(Path(__file__).resolve()), "--counts", str(nb), str(T)],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=1800,
+        cwd=str(HERE),
+    )
     if out.returncode != 0:
         raise RuntimeError(out.stderr[-2000:])
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -145,47 +157,93 @@ def run(quick: bool = False, log=print) -> dict:
     mom, w0 = bodies(N)
     body = ep.RigidBody(mom)
     tt = np.array([T_MC])
-    wall, _, n = C.best_time(lambda: ep.solve(body, tt, omega0=w0, method="exact", **wk), repeats=repeats,
-                             budget=20)
-    add("exact_montecarlo", f"exact Monte-Carlo via solve ({N} bodies x 1 time, attitude)", N / wall,
-        "evaluations/s", us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+    wall, _, n = C.best_time(lambda: ep.solve(body, tt, omega0=w0, method="exact", **wk), repeats=repeats, budget=20)
+    add(
+        "exact_montecarlo",
+        f"exact Monte-Carlo via solve ({N} bodies x 1 time, attitude)",
+        N / wall,
+        "evaluations/s",
+        us_per_evaluation=wall / N * 1e6,
+        time_s=wall,
+        timed_calls=n,
+    )
     M0 = w0 * mom
     wall, _, n = C.best_time(lambda: exact_motion(mom, M0, tt), repeats=repeats, budget=20)
-    add("exact_montecarlo_kernel", f"exact Monte-Carlo, kernel alone ({N} x 1)", N / wall, "evaluations/s",
-        us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+    add(
+        "exact_montecarlo_kernel",
+        f"exact Monte-Carlo, kernel alone ({N} x 1)",
+        N / wall,
+        "evaluations/s",
+        us_per_evaluation=wall / N * 1e6,
+        time_s=wall,
+        timed_calls=n,
+    )
     scalar = K.USE_NUMBA and hasattr(K, "motion_kernel_scalar")  # (absent before the lane kernel)
     if scalar:
         wall, _, n = C.best_time(lambda: kernel_scalar(mom, M0, tt), repeats=repeats, budget=20)
-        add("exact_montecarlo_scalar", f"exact Monte-Carlo, scalar kernel (reference of the lanes) ({N} x 1)",
-            N / wall, "evaluations/s", us_per_evaluation=wall / N * 1e6, time_s=wall, timed_calls=n)
+        add(
+            "exact_montecarlo_scalar",
+            f"exact Monte-Carlo, scalar kernel (reference of the lanes) ({N} x 1)",
+            N / wall,
+            "evaluations/s",
+            us_per_evaluation=wall / N * 1e6,
+            time_s=wall,
+            timed_calls=n,
+        )
 
     # one body at many times ---------------------------------------------------------------------
     T = cfg["many_times"]
     t = np.linspace(0.0, 100.0, T)
-    wall, _, n = C.best_time(lambda: ep.solve(list(C.INERTIA), t, omega0=C.OMEGA0, method="exact", **wk),
-                             repeats=repeats, budget=20)
-    add("exact_many_times", f"exact one body at {T} times via solve, per evaluation", wall / T * 1e6,
-        "us/evaluation", time_s=wall, timed_calls=n)
+    wall, _, n = C.best_time(
+        lambda: ep.solve(list(C.INERTIA), t, omega0=C.OMEGA0, method="exact", **wk), repeats=repeats, budget=20
+    )
+    add(
+        "exact_many_times",
+        f"exact one body at {T} times via solve, per evaluation",
+        wall / T * 1e6,
+        "us/evaluation",
+        time_s=wall,
+        timed_calls=n,
+    )
     I1 = np.array([C.INERTIA])
     M1 = I1 * np.array([C.OMEGA0])
     wall, _, n = C.best_time(lambda: exact_motion(I1, M1, t), repeats=repeats, budget=20)
-    add("exact_many_times_kernel", f"exact one body at {T} times, kernel alone, per evaluation", wall / T * 1e6,
-        "us/evaluation", time_s=wall, timed_calls=n)
+    add(
+        "exact_many_times_kernel",
+        f"exact one body at {T} times, kernel alone, per evaluation",
+        wall / T * 1e6,
+        "us/evaluation",
+        time_s=wall,
+        timed_calls=n,
+    )
     if scalar:
         wall, _, n = C.best_time(lambda: kernel_scalar(I1, M1, t), repeats=repeats, budget=20)
-        add("exact_many_times_scalar", f"exact one body at {T} times, scalar kernel, per evaluation",
-            wall / T * 1e6, "us/evaluation", time_s=wall, timed_calls=n)
+        add(
+            "exact_many_times_scalar",
+            f"exact one body at {T} times, scalar kernel, per evaluation",
+            wall / T * 1e6,
+            "us/evaluation",
+            time_s=wall,
+            timed_calls=n,
+        )
 
     # the elliptic work, counted ---------------------------------------------------------------
-    for name, nb, TT, per in (("montecarlo", cfg["count_bodies"], 1, "body"),
-                              ("many_times", 1, cfg["count_times"], "time")):
+    for name, nb, TT, per in (
+        ("montecarlo", cfg["count_bodies"], 1, "body"),
+        ("many_times", 1, cfg["count_times"], "time"),
+    ):
         try:
             cnt = _counts_subprocess(nb, TT)
         except Exception as exc:  # pragma: no cover - reported, not fatal
             log(f"  counts ({name}) failed: {exc}")
             continue
-        add(f"exact_counts_{name}", f"exact {name}: elliptic work per {per} (counted)",
-            cnt.get("R_J", 0.0), f"R_J per {per}", counts=cnt)
+        add(
+            f"exact_counts_{name}",
+            f"exact {name}: elliptic work per {per} (counted)",
+            cnt.get("R_J", 0.0),
+            f"R_J per {per}",
+            counts=cnt,
+        )
         log("    " + ", ".join(f"{k} {v:.3g}" for k, v in cnt.items()))
     return out
 

@@ -64,16 +64,32 @@ def run(quick: bool = False, log=print) -> dict:
         out["rows"].append({"name": name, "label": label, "value": value, "unit": unit, **extra})
         log(f"  {label:60s} {value:12.4g} {unit}")
 
-    cases = [("fit_100", 100, 30.0, "given"), ("fit_100_full", 100, 30.0, "fit"),
-             ("fit_10000", 1000 if quick else 10_000, 300.0, "given")]
+    cases = [
+        ("fit_100", 100, 30.0, "given"),
+        ("fit_100_full", 100, 30.0, "fit"),
+        ("fit_10000", 1000 if quick else 10_000, 300.0, "given"),
+    ]
     ep.fit(*observations(20, 5.0)[:1], attitude=observations(20, 5.0)[1], attitude_sigma=SIGMA)  # compile
     for name, n, t_end, axes in cases:
         t, q, w = observations(n, t_end)
-        wall, res, _ = C.best_time(lambda t=t, q=q, w=w, axes=axes: ep.fit(t, attitude=q, attitude_sigma=SIGMA, omega=w, omega_sigma=SIGMA,
-                                                  principal_axes=axes), repeats=repeats, budget=60)
-        add(name, f"fit: {n} attitudes + rates, t = 0..{t_end:g}, principal_axes={axes!r}", wall, "s",
-            starts=res.n_starts, optima=len(res.local_optima), reduced_chi2=res.reduced_chi2,
-            worst_z=worst_z(res), observations=n)
+        wall, res, _ = C.best_time(
+            lambda t=t, q=q, w=w, axes=axes: ep.fit(
+                t, attitude=q, attitude_sigma=SIGMA, omega=w, omega_sigma=SIGMA, principal_axes=axes
+            ),
+            repeats=repeats,
+            budget=60,
+        )
+        add(
+            name,
+            f"fit: {n} attitudes + rates, t = 0..{t_end:g}, principal_axes={axes!r}",
+            wall,
+            "s",
+            starts=res.n_starts,
+            optima=len(res.local_optima),
+            reduced_chi2=res.reduced_chi2,
+            worst_z=worst_z(res),
+            observations=n,
+        )
     return out
 
 

@@ -33,8 +33,16 @@ def run(quick: bool = False, log=print) -> dict:
 
     def row(name, label, fn, *, timed_repeats, warmup=True):
         wall, (q, om), n = C.best_time(fn, repeats=timed_repeats, budget=10.0, warmup=warmup)
-        rows.append({"name": name, "label": label, "time_s": wall, "timed_calls": n, "q": q,
-                     "energy_rel_error": C.relative_energy_error(om)})
+        rows.append(
+            {
+                "name": name,
+                "label": label,
+                "time_s": wall,
+                "timed_calls": n,
+                "q": q,
+                "energy_rel_error": C.relative_energy_error(om),
+            }
+        )
         log(f"  {label:40s} time={wall:10.4f} s  energy error={rows[-1]['energy_rel_error']:.1e}")
 
     from eulerpoisson.solvers import solve
@@ -43,6 +51,7 @@ def run(quick: bool = False, log=print) -> dict:
         def f():
             tr = solve(list(C.INERTIA), [t_end], omega0=list(C.OMEGA0), method=method, **opts)
             return tr.quaternion[0], tr.omega[0]
+
         return f
 
     row("exact", "eulerpoisson exact (one output time)", ep("exact"), timed_repeats=50)
@@ -65,8 +74,10 @@ def run(quick: bool = False, log=print) -> dict:
         r["q"] = [float(v) for v in r["q"]]
     notes = []
     if ref is None:
-        notes.append("heyoka is not installed (or --peers scipy): no high-precision reference; attitudes are "
-                     "compared with the exact method only (attitude_difference_from_exact_rad)")
+        notes.append(
+            "heyoka is not installed (or --peers scipy): no high-precision reference; attitudes are "
+            "compared with the exact method only (attitude_difference_from_exact_rad)"
+        )
     notes.append("scipy DOP853 is run over the whole interval and timed once (no warm-up, no repeats)")
     return {
         "problem": {"inertia": C.INERTIA, "omega0": C.OMEGA0, "q0": C.Q0, "t_end": t_end},

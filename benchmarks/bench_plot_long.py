@@ -60,8 +60,11 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=10_000_000)
     ap.add_argument("--dir", default="/tmp/eulerpoisson_plot_long")
     ap.add_argument("--gif", action="store_true", help="also time a 600-frame GIF")
-    ap.add_argument("--kinds", default="omega,invariants,polhode,gibbs,attitude,apex",
-                    help="comma-separated picture kinds to time (default: all)")
+    ap.add_argument(
+        "--kinds",
+        default="omega,invariants,polhode,gibbs,attitude,apex",
+        help="comma-separated picture kinds to time (default: all)",
+    )
     ap.add_argument("--repeat", type=int, default=1, help="runs of each picture; the fastest is shown")
     args = ap.parse_args(argv)
     d = Path(args.dir)
@@ -75,21 +78,25 @@ def main(argv=None) -> int:
         print(f"store of {args.samples:,} samples written in {time.perf_counter() - t0:.1f} s: {store}")
     rows = []
     t0 = time.perf_counter()
-    subprocess.run([PY, "-m", "eulerpoisson", "info", str(store)], check=True, capture_output=True) \
-        if (HERE.parent / "src" / "eulerpoisson" / "__main__.py").exists() else \
-        subprocess.run([str(Path(PY).parent / "eulerpoisson"), "info", str(store)], check=True, capture_output=True)
+    subprocess.run([PY, "-m", "eulerpoisson", "info", str(store)], check=True, capture_output=True) if (
+        HERE.parent / "src" / "eulerpoisson" / "__main__.py"
+    ).exists() else subprocess.run(
+        [str(Path(PY).parent / "eulerpoisson"), "info", str(store)], check=True, capture_output=True
+    )
     rows.append(("info (whole command)", time.perf_counter() - t0, None, None))
     for kind in [k for k in args.kinds.split(",") if k]:
         best = None
         for _ in range(max(1, args.repeat)):
-            out = subprocess.run([PY, "-c", _ONE, str(store), kind, str(d / f"{kind}.png")], check=True,
-                                 capture_output=True, text=True).stdout.split()
+            out = subprocess.run(
+                [PY, "-c", _ONE, str(store), kind, str(d / f"{kind}.png")], check=True, capture_output=True, text=True
+            ).stdout.split()
             if best is None or float(out[0]) < best[0]:
                 best = (float(out[0]), float(out[1]), float(out[2]))
         rows.append((f"plot --kind {kind}", best[0], best[1], best[2]))
     if args.gif:
-        out = subprocess.run([PY, "-c", _GIF, str(d / "racket.gif")], check=True, capture_output=True,
-                             text=True).stdout.split()
+        out = subprocess.run(
+            [PY, "-c", _GIF, str(d / "racket.gif")], check=True, capture_output=True, text=True
+        ).stdout.split()
         rows.append(("GIF, 600 frames 640x480", float(out[0]), float(out[1]), None))
     try:
         cpus = len(os.sched_getaffinity(0))

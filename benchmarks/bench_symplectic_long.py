@@ -59,9 +59,11 @@ def run(name, steps, batch):
     nst = tr.stats.get("steps", steps)
     per = wall / max(nst, 1) * 1e6
     kind = "compiled" if tr.stats.get("compiled") else "numpy"
-    print(f"{name:20s} steps={nst:7d} batch={batch:5d} wall={wall:8.2f}s  {per:8.1f} us/step "
-          f"({per / batch:7.3f} us/body-step, {kind})  max|dm|/|m|={m:.2e}  "
-          f"chart changes={tr.stats.get('chart_changes', 0)}")
+    print(
+        f"{name:20s} steps={nst:7d} batch={batch:5d} wall={wall:8.2f}s  {per:8.1f} us/step "
+        f"({per / batch:7.3f} us/body-step, {kind})  max|dm|/|m|={m:.2e}  "
+        f"chart changes={tr.stats.get('chart_changes', 0)}"
+    )
     print("    energy error per window:", " ".join(f"{w:.1e}" for w in windows))
 
 

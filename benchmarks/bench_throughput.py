@@ -90,41 +90,77 @@ def run(quick: bool = False, log=print) -> dict:
     w0 = bodies(B)
     t = np.linspace(0.0, 100.0, T)
     wall, tr, n = C.best_time(lambda: solve(I, t, omega0=w0, method="exact", workers=1), repeats=repeats, budget=20)
-    add("exact_solve", f"exact via solve ({B} bodies x {T} times)", B * T / wall, "evaluations/s",
-        us_per_evaluation=wall / (B * T) * 1e6, time_s=wall, timed_calls=n)
+    add(
+        "exact_solve",
+        f"exact via solve ({B} bodies x {T} times)",
+        B * T / wall,
+        "evaluations/s",
+        us_per_evaluation=wall / (B * T) * 1e6,
+        time_s=wall,
+        timed_calls=n,
+    )
     M0 = w0 * np.asarray(C.INERTIA)
     wall, _, n = C.best_time(lambda: exact_motion(np.asarray(C.INERTIA), M0, t), repeats=repeats, budget=20)
-    add("exact_kernel", f"exact kernel exact_motion ({B} x {T})", B * T / wall, "evaluations/s",
-        us_per_evaluation=wall / (B * T) * 1e6, time_s=wall, timed_calls=n)
+    add(
+        "exact_kernel",
+        f"exact kernel exact_motion ({B} x {T})",
+        B * T / wall,
+        "evaluations/s",
+        us_per_evaluation=wall / (B * T) * 1e6,
+        time_s=wall,
+        timed_calls=n,
+    )
 
     # taylor --------------------------------------------------------------------------
     B, te = cfg["taylor_bodies"], cfg["taylor_t_end"]
     w0 = bodies(B)
-    wall, tr, n = C.best_time(lambda: solve(I, [te], omega0=w0, method="taylor", tol=C.EPS, workers=1),
-                              repeats=repeats, budget=30)
-    add("taylor_batch", f"taylor tol=eps batch ({B} bodies to t={te:g})", B * te / wall, "body-seconds/s",
-        time_s=wall, timed_calls=n, steps=tr.stats.get("steps"))
+    wall, tr, n = C.best_time(
+        lambda: solve(I, [te], omega0=w0, method="taylor", tol=C.EPS, workers=1), repeats=repeats, budget=30
+    )
+    add(
+        "taylor_batch",
+        f"taylor tol=eps batch ({B} bodies to t={te:g})",
+        B * te / wall,
+        "body-seconds/s",
+        time_s=wall,
+        timed_calls=n,
+        steps=tr.stats.get("steps"),
+    )
     hy = C.heyoka_module()
     if hy is not None:
         rate, bs, wall, nb = C.heyoka_batch_throughput(hy, w0, te)
-        add("heyoka_batch", f"heyoka batch mode tol=eps (SIMD width {bs}, {nb} bodies)", rate, "body-seconds/s",
-            time_s=wall, simd_width=bs)
+        add(
+            "heyoka_batch",
+            f"heyoka batch mode tol=eps (SIMD width {bs}, {nb} bodies)",
+            rate,
+            "body-seconds/s",
+            time_s=wall,
+            simd_width=bs,
+        )
         peer = C.HeyokaPeer(hy, C.EPS)
         wall1, _, _ = C.best_time(lambda: peer.run(C.T_REF), repeats=5, budget=2)
-        add("heyoka_scalar", "heyoka scalar mode tol=eps (one body)", C.T_REF / wall1, "body-seconds/s",
-            time_s=wall1)
+        add("heyoka_scalar", "heyoka scalar mode tol=eps (one body)", C.T_REF / wall1, "body-seconds/s", time_s=wall1)
 
     # symplectic ----------------------------------------------------------------------
     B, ns, dt = cfg["symplectic_bodies"], cfg["symplectic_steps"], cfg["symplectic_dt"]
     w0 = bodies(B)
     for scheme, extra in (("splitting", {}), ("splitting4", {}), ("gauss4", {"variables": "quaternion"})):
         wall, tr, n = C.best_time(
-            lambda scheme=scheme, extra=extra: solve(I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt,
-                                                     workers=1, **extra),
-            repeats=repeats, budget=30)
+            lambda scheme=scheme, extra=extra: solve(
+                I, [ns * dt], omega0=w0, method="symplectic", scheme=scheme, dt=dt, workers=1, **extra
+            ),
+            repeats=repeats,
+            budget=30,
+        )
         steps = int(tr.stats["steps"])
-        add(f"symplectic_{scheme}", f"symplectic {scheme} batch ({B} bodies x {steps} steps)", B * steps / wall,
-            "body-steps/s", time_s=wall, timed_calls=n)
+        add(
+            f"symplectic_{scheme}",
+            f"symplectic {scheme} batch ({B} bodies x {steps} steps)",
+            B * steps / wall,
+            "body-steps/s",
+            time_s=wall,
+            timed_calls=n,
+        )
 
     # threads: one against every core -------------------------------------------------------
     from eulerpoisson.solvers.parallel import available_cores
@@ -138,24 +174,51 @@ def run(quick: bool = False, log=print) -> dict:
     we, wt, ws = bodies(Be), bodies(Bt), bodies(Bs)
     te_grid = np.linspace(0.0, 100.0, Te)
     jobs = {
-        "exact": (lambda k: solve(I, te_grid, omega0=we, method="exact", workers=k),
-                  f"exact ({Be} bodies x {Te} times)", lambda tr: Be * Te, "evaluations/s"),
-        "taylor": (lambda k: solve(I, [tt], omega0=wt, method="taylor", tol=C.EPS, workers=k),
-                   f"taylor tol=eps ({Bt} bodies to t={tt:g})", lambda tr: Bt * tt, "body-seconds/s"),
-        "symplectic": (lambda k: solve(I, [nsteps * hs], omega0=ws, method="symplectic", dt=hs, workers=k),
-                       f"symplectic gauss4 ({Bs} bodies x {nsteps} steps)", lambda tr: Bs * int(tr.stats["steps"]),
-                       "body-steps/s"),
+        "exact": (
+            lambda k: solve(I, te_grid, omega0=we, method="exact", workers=k),
+            f"exact ({Be} bodies x {Te} times)",
+            lambda tr: Be * Te,
+            "evaluations/s",
+        ),
+        "taylor": (
+            lambda k: solve(I, [tt], omega0=wt, method="taylor", tol=C.EPS, workers=k),
+            f"taylor tol=eps ({Bt} bodies to t={tt:g})",
+            lambda tr: Bt * tt,
+            "body-seconds/s",
+        ),
+        "symplectic": (
+            lambda k: solve(I, [nsteps * hs], omega0=ws, method="symplectic", dt=hs, workers=k),
+            f"symplectic gauss4 ({Bs} bodies x {nsteps} steps)",
+            lambda tr: Bs * int(tr.stats["steps"]),
+            "body-steps/s",
+        ),
     }
     for name, (fn, what, count, unit) in jobs.items():
         trial = fn(cores)
         threads, amount = trial.stats["threads"], count(trial)
-        best = alternate_best({1: lambda fn=fn: fn(1), cores: lambda fn=fn: fn(cores)}, repeats=2 if quick else 15,
-                              budget=2.0 if quick else 30.0)
+        best = alternate_best(
+            {1: lambda fn=fn: fn(1), cores: lambda fn=fn: fn(cores)},
+            repeats=2 if quick else 15,
+            budget=2.0 if quick else 30.0,
+        )
         add(f"threads_{name}_1", f"{what}, 1 thread", amount / best[1], unit, time_s=best[1], workers=1)
-        add(f"threads_{name}_all", f"{what}, workers={cores} (threads: {threads})", amount / best[cores], unit,
-            time_s=best[cores], workers=cores, threads=threads)
-        add(f"threads_{name}_speedup", f"{name}: speed-up on {cores} cores (best of alternating runs)",
-            best[1] / best[cores], "x", cores=cores, threads=threads)
+        add(
+            f"threads_{name}_all",
+            f"{what}, workers={cores} (threads: {threads})",
+            amount / best[cores],
+            unit,
+            time_s=best[cores],
+            workers=cores,
+            threads=threads,
+        )
+        add(
+            f"threads_{name}_speedup",
+            f"{name}: speed-up on {cores} cores (best of alternating runs)",
+            best[1] / best[cores],
+            "x",
+            cores=cores,
+            threads=threads,
+        )
 
     # taylor on every core against heyoka's ensemble propagation on as many threads -----------
     if hy is not None:
@@ -164,12 +227,32 @@ def run(quick: bool = False, log=print) -> dict:
             fn, bs, nb = C.heyoka_ensemble(hy, wt, tt, cores, per_thread=per_thread)
             jobs["per_thread" if per_thread else "ensemble"] = fn
         best = alternate_best(jobs, repeats=2 if quick else 10, budget=2.0 if quick else 30.0)
-        add("threads_taylor_vs_heyoka_taylor", f"taylor tol=eps ({Bt} bodies to t={tt:g}), workers={cores}",
-            Bt * tt / best["taylor"], "body-seconds/s", time_s=best["taylor"], workers=cores)
-        add("heyoka_ensemble", f"heyoka ensemble_propagate_until_batch, {cores} threads (SIMD {bs}, {nb} bodies)",
-            nb * tt / best["ensemble"], "body-seconds/s", time_s=best["ensemble"], workers=cores, simd_width=bs)
-        add("heyoka_per_thread", f"heyoka batch integrator per thread, {cores} threads (hand-written, {nb} bodies)",
-            nb * tt / best["per_thread"], "body-seconds/s", time_s=best["per_thread"], workers=cores, simd_width=bs)
+        add(
+            "threads_taylor_vs_heyoka_taylor",
+            f"taylor tol=eps ({Bt} bodies to t={tt:g}), workers={cores}",
+            Bt * tt / best["taylor"],
+            "body-seconds/s",
+            time_s=best["taylor"],
+            workers=cores,
+        )
+        add(
+            "heyoka_ensemble",
+            f"heyoka ensemble_propagate_until_batch, {cores} threads (SIMD {bs}, {nb} bodies)",
+            nb * tt / best["ensemble"],
+            "body-seconds/s",
+            time_s=best["ensemble"],
+            workers=cores,
+            simd_width=bs,
+        )
+        add(
+            "heyoka_per_thread",
+            f"heyoka batch integrator per thread, {cores} threads (hand-written, {nb} bodies)",
+            nb * tt / best["per_thread"],
+            "body-seconds/s",
+            time_s=best["per_thread"],
+            workers=cores,
+            simd_width=bs,
+        )
 
     # scipy ellipj yardstick ------------------------------------------------------------
     from scipy.special import ellipj
@@ -179,8 +262,14 @@ def run(quick: bool = False, log=print) -> dict:
     u = rng.uniform(0.0, 10.0, N)
     m = rng.uniform(0.0, 0.99, N)
     wall, _, n = C.best_time(lambda: ellipj(u, m), repeats=repeats, budget=10)
-    add("scipy_ellipj", f"scipy.special.ellipj ({N} evaluations)", wall / N * 1e9, "ns/evaluation",
-        time_s=wall, timed_calls=n)
+    add(
+        "scipy_ellipj",
+        f"scipy.special.ellipj ({N} evaluations)",
+        wall / N * 1e9,
+        "ns/evaluation",
+        time_s=wall,
+        timed_calls=n,
+    )
     return out
 
 

@@ -47,19 +47,36 @@ def run(quick: bool = False, log=print) -> dict:
     def taylor(t1, **kw):
         return lambda: ep.solve(I_FULL, [t1], omega0=W0, attitude0=Q0, method="taylor", tol=C.EPS, **kw)
 
-    runs = {"free": taylor(t_end_steps), "free0": taylor(0.0), "gravity": taylor(t_end_steps, torque=grav),
-            "gravity0": taylor(0.0, torque=grav)}
+    runs = {
+        "free": taylor(t_end_steps),
+        "free0": taylor(0.0),
+        "gravity": taylor(t_end_steps, torque=grav),
+        "gravity0": taylor(0.0, torque=grav),
+    }
     from bench_throughput import alternate_best
 
     best = alternate_best(runs, repeats=3 if quick else 15, budget=3.0 if quick else 20.0)
     tr_f, tr_g = runs["free"](), runs["gravity"]()
     us_f = (best["free"] - best["free0"]) / tr_f.stats["steps"] * 1e6
     us_g = (best["gravity"] - best["gravity0"]) / tr_g.stats["steps"] * 1e6
-    add("taylor_free_step", f"taylor free body, tol=eps, per step (order {tr_f.stats['max_order']}, t = {t_end_steps:g})",
-        us_f, "us/step", steps=tr_f.stats["steps"], time_s=best["free"], call_overhead_s=best["free0"])
-    add("taylor_gravity_step",
-        f"taylor heavy top, tol=eps, per step (order {tr_g.stats['max_order']}, t = {t_end_steps:g})", us_g,
-        "us/step", steps=tr_g.stats["steps"], time_s=best["gravity"], call_overhead_s=best["gravity0"])
+    add(
+        "taylor_free_step",
+        f"taylor free body, tol=eps, per step (order {tr_f.stats['max_order']}, t = {t_end_steps:g})",
+        us_f,
+        "us/step",
+        steps=tr_f.stats["steps"],
+        time_s=best["free"],
+        call_overhead_s=best["free0"],
+    )
+    add(
+        "taylor_gravity_step",
+        f"taylor heavy top, tol=eps, per step (order {tr_g.stats['max_order']}, t = {t_end_steps:g})",
+        us_g,
+        "us/step",
+        steps=tr_g.stats["steps"],
+        time_s=best["gravity"],
+        call_overhead_s=best["gravity0"],
+    )
     add("taylor_gravity_ratio", "taylor: heavy-top step / free-body step", us_g / us_f, "x")
 
     # exact Lagrange top
@@ -69,19 +86,43 @@ def run(quick: bool = False, log=print) -> dict:
     w0 = np.stack([rng.normal(0, 1, B), rng.normal(0, 1, B), spins], -1)
     top = Gravity(1.0, [0.0, 0.0, 0.1])
     t = np.linspace(0.0, 100.0, T)
-    wall, _, _ = C.best_time(lambda: ep.solve([1.0, 1.0, 0.5], t, omega0=w0, attitude0=Q0, torque=top,
-                                              method="exact"), repeats=repeats, budget=20)
-    add("exact_lagrange", f"exact Lagrange top ({B} bodies x {T} times), per evaluation", wall / (B * T) * 1e6,
-        "us/evaluation", time_s=wall)
+    wall, _, _ = C.best_time(
+        lambda: ep.solve([1.0, 1.0, 0.5], t, omega0=w0, attitude0=Q0, torque=top, method="exact"),
+        repeats=repeats,
+        budget=20,
+    )
+    add(
+        "exact_lagrange",
+        f"exact Lagrange top ({B} bodies x {T} times), per evaluation",
+        wall / (B * T) * 1e6,
+        "us/evaluation",
+        time_s=wall,
+    )
 
     # symplectic exact splitting
     nsteps = 10_000 if quick else 200_000
     dt = 0.01
-    wall, tr, _ = C.best_time(lambda: ep.solve(I_FULL, [nsteps * dt], omega0=W0, attitude0=Q0, torque=grav,
-                                               method="symplectic", scheme="exact_splitting", dt=dt),
-                              repeats=repeats, budget=20)
-    add("symplectic_exact_splitting", f"symplectic exact_splitting, heavy top ({tr.stats['steps']} steps)",
-        tr.stats["steps"] / wall, "body-steps/s", time_s=wall)
+    wall, tr, _ = C.best_time(
+        lambda: ep.solve(
+            I_FULL,
+            [nsteps * dt],
+            omega0=W0,
+            attitude0=Q0,
+            torque=grav,
+            method="symplectic",
+            scheme="exact_splitting",
+            dt=dt,
+        ),
+        repeats=repeats,
+        budget=20,
+    )
+    add(
+        "symplectic_exact_splitting",
+        f"symplectic exact_splitting, heavy top ({tr.stats['steps']} steps)",
+        tr.stats["steps"] / wall,
+        "body-steps/s",
+        time_s=wall,
+    )
 
     # accuracy against the 40-digit reference at t = 10
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
@@ -89,11 +130,22 @@ def run(quick: bool = False, log=print) -> dict:
 
     qr, _ = reference_motion(I_FULL, Q0, W0, [10.0], gravity=[(MASS, COM, [0.0, 0.0, -9.81])])
     for name, opts in (("taylor", {"tol": C.EPS}), ("rk", {"integrator": "DOP853", "tol": 1e-13})):
-        wall, tr, _ = C.best_time(lambda name=name, opts=opts: ep.solve(I_FULL, [10.0], omega0=W0, attitude0=Q0,
-                                                                        torque=grav, method=name, **opts), repeats=repeats, budget=10)
+        wall, tr, _ = C.best_time(
+            lambda name=name, opts=opts: ep.solve(
+                I_FULL, [10.0], omega0=W0, attitude0=Q0, torque=grav, method=name, **opts
+            ),
+            repeats=repeats,
+            budget=10,
+        )
         err = C.attitude_error(tr.quaternion[-1], qr[0])
-        add(f"heavy_top_{name}", f"heavy asymmetric top to t = 10: {name} ({opts})", wall * 1e3, "ms",
-            attitude_error_rad=err, time_s=wall)
+        add(
+            f"heavy_top_{name}",
+            f"heavy asymmetric top to t = 10: {name} ({opts})",
+            wall * 1e3,
+            "ms",
+            attitude_error_rad=err,
+            time_s=wall,
+        )
     return out
 
 

@@ -130,39 +130,90 @@ def run(quick: bool = False, log=print) -> dict:
             pts.append(p)
             ks = "-" if k is None else f"{k:.3g}"
             log(f"  {label:44s} {knob_name}={ks:<9s} time={p['time_s'] * 1e3:10.3f} ms  error={p['error_rad']:.2e} rad")
-        curves.append({"name": name, "label": label, "family": family, "peer": peer, "knob": knob_name,
-                       "points": pts})
+        curves.append({"name": name, "label": label, "family": family, "peer": peer, "knob": knob_name, "points": pts})
 
     # --- eulerpoisson -----------------------------------------------------------------
     curve("exact", "eulerpoisson exact", "exact", "none", [None], lambda _: _ep_runner("exact"))
-    curve("taylor", "eulerpoisson taylor", "taylor", "tol", sw["taylor"],
-          lambda k: _ep_runner("taylor", tol=k))
-    curve("symplectic-splitting", "eulerpoisson symplectic splitting", "symplectic", "dt", sw["splitting"],
-          lambda k: _ep_runner("symplectic", scheme="splitting", dt=k))
-    curve("symplectic-splitting4", "eulerpoisson symplectic splitting4", "symplectic", "dt", sw["splitting4"],
-          lambda k: _ep_runner("symplectic", scheme="splitting4", dt=k))
-    curve("symplectic-gauss4", "eulerpoisson symplectic gauss4 (quaternion)", "symplectic", "dt", sw["gauss4"],
-          lambda k: _ep_runner("symplectic", scheme="gauss4", variables="quaternion", dt=k))
-    curve("symplectic-gauss6", "eulerpoisson symplectic gauss6 (quaternion)", "symplectic", "dt", sw["gauss6"],
-          lambda k: _ep_runner("symplectic", scheme="gauss6", variables="quaternion", dt=k))
-    curve("rk-DOP853", "eulerpoisson rk DOP853", "rk", "tol", sw["rk-DOP853"],
-          lambda k: _ep_runner("rk", integrator="DOP853", tol=k))
-    curve("rk-RK45", "eulerpoisson rk RK45", "rk", "tol", sw["rk-RK45"],
-          lambda k: _ep_runner("rk", integrator="RK45", tol=k))
+    curve("taylor", "eulerpoisson taylor", "taylor", "tol", sw["taylor"], lambda k: _ep_runner("taylor", tol=k))
+    curve(
+        "symplectic-splitting",
+        "eulerpoisson symplectic splitting",
+        "symplectic",
+        "dt",
+        sw["splitting"],
+        lambda k: _ep_runner("symplectic", scheme="splitting", dt=k),
+    )
+    curve(
+        "symplectic-splitting4",
+        "eulerpoisson symplectic splitting4",
+        "symplectic",
+        "dt",
+        sw["splitting4"],
+        lambda k: _ep_runner("symplectic", scheme="splitting4", dt=k),
+    )
+    curve(
+        "symplectic-gauss4",
+        "eulerpoisson symplectic gauss4 (quaternion)",
+        "symplectic",
+        "dt",
+        sw["gauss4"],
+        lambda k: _ep_runner("symplectic", scheme="gauss4", variables="quaternion", dt=k),
+    )
+    curve(
+        "symplectic-gauss6",
+        "eulerpoisson symplectic gauss6 (quaternion)",
+        "symplectic",
+        "dt",
+        sw["gauss6"],
+        lambda k: _ep_runner("symplectic", scheme="gauss6", variables="quaternion", dt=k),
+    )
+    curve(
+        "rk-DOP853",
+        "eulerpoisson rk DOP853",
+        "rk",
+        "tol",
+        sw["rk-DOP853"],
+        lambda k: _ep_runner("rk", integrator="DOP853", tol=k),
+    )
+    curve(
+        "rk-RK45",
+        "eulerpoisson rk RK45",
+        "rk",
+        "tol",
+        sw["rk-RK45"],
+        lambda k: _ep_runner("rk", integrator="RK45", tol=k),
+    )
 
     # --- peers --------------------------------------------------------------------------
-    curve("scipy-DOP853", "scipy solve_ivp DOP853 (rtol=atol)", "peer", "rtol", sw["scipy-DOP853"],
-          lambda k: _scipy_runner("DOP853", k), peer=True)
-    curve("scipy-RK45", "scipy solve_ivp RK45 (rtol=atol)", "peer", "rtol", sw["scipy-RK45"],
-          lambda k: _scipy_runner("RK45", k), peer=True)
+    curve(
+        "scipy-DOP853",
+        "scipy solve_ivp DOP853 (rtol=atol)",
+        "peer",
+        "rtol",
+        sw["scipy-DOP853"],
+        lambda k: _scipy_runner("DOP853", k),
+        peer=True,
+    )
+    curve(
+        "scipy-RK45",
+        "scipy solve_ivp RK45 (rtol=atol)",
+        "peer",
+        "rtol",
+        sw["scipy-RK45"],
+        lambda k: _scipy_runner("RK45", k),
+        peer=True,
+    )
     if hy is not None:
+
         def make_hy(k):
             peer = C.HeyokaPeer(hy, k)
             return peer.run
+
         curve("heyoka", f"heyoka {hy.__version__} taylor_adaptive", "peer", "tol", sw["heyoka"], make_hy, peer=True)
     else:
         notes.append("heyoka is not installed (or --peers scipy): no heyoka curve (pip install heyoka)")
     if mj is not None:
+
         def make_mj(k):
             peer = C.MujocoPeer(mj, k)
 
@@ -171,8 +222,10 @@ def run(quick: bool = False, log=print) -> dict:
                 return q, om, {"steps": n}
 
             return run_mj
-        curve("mujoco-RK4", f"MuJoCo {mj.__version__} RK4 (fixed dt)", "peer", "dt", sw["mujoco-RK4"], make_mj,
-              peer=True)
+
+        curve(
+            "mujoco-RK4", f"MuJoCo {mj.__version__} RK4 (fixed dt)", "peer", "dt", sw["mujoco-RK4"], make_mj, peer=True
+        )
     else:
         notes.append("MuJoCo is not installed (or --peers scipy): no MuJoCo curve (pip install mujoco)")
     notes.append("Basilisk is not measured (not installed); the issue quotes RK4 dt=1e-3: 2e-13 rad, 860 ms.")
@@ -180,8 +233,10 @@ def run(quick: bool = False, log=print) -> dict:
         "problem": {"inertia": C.INERTIA, "omega0": C.OMEGA0, "q0": C.Q0, "t_end": t_end},
         "error_measure": "rotation angle (rad) between the computed attitude and the reference at t_end",
         "reference": {"source": ref["source"], "q": [str(v) for v in ref["q"]], "crosscheck": ref["crosscheck"]},
-        "timing": ("best of up to 25 calls (fewer for slow ones: about 1.5 s per point) after one warm-up "
-                   "call (time.perf_counter); compilation (numba, heyoka LLVM, MuJoCo model) not timed"),
+        "timing": (
+            "best of up to 25 calls (fewer for slow ones: about 1.5 s per point) after one warm-up "
+            "call (time.perf_counter); compilation (numba, heyoka LLVM, MuJoCo model) not timed"
+        ),
         "curves": curves,
         "notes": notes,
     }
@@ -224,8 +279,14 @@ def plot(payload: dict, path) -> None:
         if c["knob"] in ("tol", "rtol", "dt"):
             for p, xi, yi in zip(c["points"], x, y):
                 if p is c["points"][0] or p is c["points"][-1]:
-                    ax.annotate(f"{p['knob']:.0e}" if p["knob"] < 1e-3 else f"{p['knob']:g}", (xi, yi),
-                                textcoords="offset points", xytext=(4, 3), fontsize=7, color=st.get("color"))
+                    ax.annotate(
+                        f"{p['knob']:.0e}" if p["knob"] < 1e-3 else f"{p['knob']:g}",
+                        (xi, yi),
+                        textcoords="offset points",
+                        xytext=(4, 3),
+                        fontsize=7,
+                        color=st.get("color"),
+                    )
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("wall time per solve (s), best of repeats, one thread")
@@ -240,7 +301,8 @@ def plot(payload: dict, path) -> None:
         f"Work-precision, I = diag(1, 2, 3), $\\Omega_0$ = (1, 0.1, 0.5), t = {payload['problem']['t_end']:g}{quick}\n"
         f"{C.machine_line(m)}\n"
         f"reference: {payload['reference']['source']}; labels: tol / rtol / dt at the ends of each curve",
-        fontsize=9.5, x=0.40,
+        fontsize=9.5,
+        x=0.40,
     )
     fig.text(0.01, 0.005, f"{payload['generated']}  command: {payload['command']}", fontsize=7, color="0.4")
     fig.savefig(path, dpi=110)

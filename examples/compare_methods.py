@@ -37,8 +37,10 @@ for method, opts in runs.items():
     tr = ep.solve(body, t, omega0=omega0, method=method, **opts)
     wall = time.perf_counter() - start
     err = ep.Attitude(tr.quaternion[-1]).angle_to(ep.Attitude(truth.quaternion[-1]))
-    print(f"{method:11s} {str(opts):40s} attitude error at t=100: {err:.1e} rad   "
-          f"energy drift {tr.drift()['energy']:.1e}   {wall * 1e3:8.2f} ms")
+    print(
+        f"{method:11s} {str(opts):40s} attitude error at t=100: {err:.1e} rad   "
+        f"energy drift {tr.drift()['energy']:.1e}   {wall * 1e3:8.2f} ms"
+    )
     errors.append(max(err, 1e-17))  # the closed form against itself: round-off (drawn at 1e-17 if 0)
     walls.append(wall * 1e3)
 

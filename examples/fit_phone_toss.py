@@ -47,14 +47,18 @@ def main(out="phone_fit") -> dict:
         periods = ep.analysis.tumbling_periods(np.diag(res.inertia), omega0=res.omega0)
         print(f"{name}:")
         print(res.summary())
-        print(f"  period of Omega(t) {periods['P_omega']:.4f} s, mean precession {periods['P_phi']:.4f} s "
-              f"({periods['mode']}); flips every {periods['P_omega'] / 2:.4f} s")
+        print(
+            f"  period of Omega(t) {periods['P_omega']:.4f} s, mean precession {periods['P_phi']:.4f} s "
+            f"({periods['mode']}); flips every {periods['P_omega'] / 2:.4f} s"
+        )
         res.save_plots(out / name)
     a, b = (results[n] for n in ("phone_toss_1", "phone_toss_2"))
     for k in ("I_xx", "I_yy", "I_zz"):
         z = (a.parameters[k] - b.parameters[k]) / np.hypot(a.stderr[k], b.stderr[k])
-        print(f"{k}: toss 1 {a.parameters[k]:.5f} +- {a.stderr[k]:.5f}, toss 2 {b.parameters[k]:.5f} +- "
-              f"{b.stderr[k]:.5f} ({z:+.2f} sigma apart)")
+        print(
+            f"{k}: toss 1 {a.parameters[k]:.5f} +- {a.stderr[k]:.5f}, toss 2 {b.parameters[k]:.5f} +- "
+            f"{b.stderr[k]:.5f} ({z:+.2f} sigma apart)"
+        )
     # prediction: fit the first half of toss 1, predict the second half
     obs = read_observations(DATA / "phone_toss_1.csv")
     kw = obs.fit_kwargs()
@@ -64,8 +68,10 @@ def main(out="phone_fit") -> dict:
     pred = early.predict(tt)
     late = ~half
     err = np.abs(early.predict(kw["t"][late]).omega - kw["omega"][late])
-    print(f"prediction from t <= 0.3 s of toss 1: rms error over the next {kw['t'][-1] - 0.3:.2f} s "
-          f"{np.sqrt(np.mean(err**2)):.3f} rad/s (rates up to {np.abs(kw['omega']).max():.1f} rad/s)")
+    print(
+        f"prediction from t <= 0.3 s of toss 1: rms error over the next {kw['t'][-1] - 0.3:.2f} s "
+        f"{np.sqrt(np.mean(err**2)):.3f} rad/s (rates up to {np.abs(kw['omega']).max():.1f} rad/s)"
+    )
     import matplotlib
 
     matplotlib.use("Agg")

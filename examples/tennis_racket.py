@@ -25,7 +25,12 @@ tr = ep.solve(body, np.linspace(0.0, 300.0, 3001), omega0=M0 / body.principal_mo
 
 flips = flip_times(tr, component=1)
 print("flips of Omega_2 at t =", np.round(flips, 6))
-print("time between flips:", np.diff(flips).mean(), " closed form 2K/lambda:", tennis_racket_half_period(body.principal_moments, M0))
+print(
+    "time between flips:",
+    np.diff(flips).mean(),
+    " closed form 2K/lambda:",
+    tennis_racket_half_period(body.principal_moments, M0),
+)
 print("relative drift of the integrals:", {k: f"{v:.1e}" for k, v in tr.drift().items()})
 OUT.mkdir(parents=True, exist_ok=True)
 plots.plot(tr, "omega", out=OUT / "tennis_racket.png")

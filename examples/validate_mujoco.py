@@ -67,8 +67,9 @@ def simulate(integrator: str, dt: float, *, inertia=INERTIA, omega0=OMEGA0, t_en
 
 def write_csv(path, t, q, w) -> None:
     """A run as ``t,qw,qx,qy,qz,wx,wy,wz`` with 17 significant digits."""
-    np.savetxt(path, np.column_stack([t, q, w]), delimiter=",", header="t,qw,qx,qy,qz,wx,wy,wz", comments="",
-               fmt="%.17g")
+    np.savetxt(
+        path, np.column_stack([t, q, w]), delimiter=",", header="t,qw,qx,qy,qz,wx,wy,wz", comments="", fmt="%.17g"
+    )
 
 
 def main(out="out/mujoco") -> list:
@@ -83,17 +84,26 @@ def main(out="out/mujoco") -> list:
         path = out / f"mujoco_{integ.lower()}.csv"
         write_csv(path, *simulate(integ, dt))
         reports.append((label, validate(path, INERTIA, tolerance=TOLERANCE)))
-    print(f"MuJoCo {mujoco.__version__}, racket I = {INERTIA}, Omega0 = {OMEGA0}, t = 0 to {T_END:g} s, "
-          f"tolerance {TOLERANCE:g} rad")
-    print("| MuJoCo integrator | max attitude error (rad) | max omega error | energy drift | momentum drift | "
-          "largest flip time error (s) | verdict |")
+    print(
+        f"MuJoCo {mujoco.__version__}, racket I = {INERTIA}, Omega0 = {OMEGA0}, t = 0 to {T_END:g} s, "
+        f"tolerance {TOLERANCE:g} rad"
+    )
+    print(
+        "| MuJoCo integrator | max attitude error (rad) | max omega error | energy drift | momentum drift | "
+        "largest flip time error (s) | verdict |"
+    )
     print("|---|---|---|---|---|---|---|")
     for label, r in reports:
         fe = max(abs(e) for e in r.flip_time_errors) if r.flip_time_errors else float("nan")
-        print(f"| {label} | {r.max_attitude_error:.2g} | {r.max_omega_error:.2g} | {r.energy_drift:.2g} | "
-              f"{r.momentum_drift:.2g} | {fe:.2g} | {r.verdict} |")
-    plot_report(reports, out / "validate_mujoco.png",
-                title=f"MuJoCo {mujoco.__version__}: a flat racket spun near its intermediate axis")
+        print(
+            f"| {label} | {r.max_attitude_error:.2g} | {r.max_omega_error:.2g} | {r.energy_drift:.2g} | "
+            f"{r.momentum_drift:.2g} | {fe:.2g} | {r.verdict} |"
+        )
+    plot_report(
+        reports,
+        out / "validate_mujoco.png",
+        title=f"MuJoCo {mujoco.__version__}: a flat racket spun near its intermediate axis",
+    )
     return reports
 
 

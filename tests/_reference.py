@@ -7,12 +7,14 @@ from scipy.integrate import solve_ivp
 def _qmul(p, q):
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return np.array([
-        pw * qw - px * qx - py * qy - pz * qz,
-        pw * qx + px * qw + py * qz - pz * qy,
-        pw * qy - px * qz + py * qw + pz * qx,
-        pw * qz + px * qy - py * qx + pz * qw,
-    ])
+    return np.array(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ]
+    )
 
 
 def reference_motion(inertia, omega0, q0, t, rtol=1e-13, atol=1e-13):
@@ -55,5 +57,5 @@ def quaternion_distance(q1, q2):
     q1 = np.asarray(q1, float)
     q2 = np.asarray(q2, float)
     w = np.sum(q1 * q2, axis=-1)
-    v = (q1[..., :1] * q2[..., 1:] - q2[..., :1] * q1[..., 1:] - np.cross(q1[..., 1:], q2[..., 1:]))
+    v = q1[..., :1] * q2[..., 1:] - q2[..., :1] * q1[..., 1:] - np.cross(q1[..., 1:], q2[..., 1:])
     return 2 * np.arctan2(np.linalg.norm(v, axis=-1), np.abs(w))

@@ -196,7 +196,7 @@ def _normalise_gravity(gravity):
     if gravity is None:
         return []
     if isinstance(gravity, tuple) and len(gravity) == 3 and not hasattr(gravity[0], "__len__"):
-        gravity = [gravity]     # a single (mass, c, g) term
+        gravity = [gravity]  # a single (mass, c, g) term
     out = []
     for term in gravity:
         mass, c, g = term
@@ -235,13 +235,14 @@ class _System:
             for i in range(3):
                 for j in range(3):
                     A[i][j] += mass * cx[i][j]
-        self.aux = []          # list of (V0 fixed (3,), A fixed (3x3) or None for identity, scale float)
+        self.aux = []  # list of (V0 fixed (3,), A fixed (3x3) or None for identity, scale float)
         torque_bound = mpmath.mpf(0)
         for key, A in groups.items():
             V = _matTvec(R, list(key))
             gn = _norm(list(key))
-            self.aux.append(([_to_fix(a, P) for a in V], [[_to_fix(A[i][j], P) for j in range(3)] for i in range(3)],
-                             float(gn)))
+            self.aux.append(
+                ([_to_fix(a, P) for a in V], [[_to_fix(A[i][j], P) for j in range(3)] for i in range(3)], float(gn))
+            )
             torque_bound += mpmath.sqrt(sum(A[i][j] ** 2 for i in range(3) for j in range(3))) * gn
         if space_torque is not None:
             ts = _vec_mp(space_torque, name="space_torque")
@@ -259,10 +260,14 @@ class _System:
         self.gg = None
         if nu is not None and _mpf(nu) != 0:
             nu = _mpf(nu)
-            r0 = [R[0][0], R[0][1], R[0][2]]   # R^T e_x
-            z0 = [R[2][0], R[2][1], R[2][2]]   # R^T e_z
-            self.gg = (_to_fix(nu, P), _to_fix(3 * nu * nu, P), [_to_fix(a, P) for a in r0],
-                       [_to_fix(a, P) for a in z0])
+            r0 = [R[0][0], R[0][1], R[0][2]]  # R^T e_x
+            z0 = [R[2][0], R[2][1], R[2][2]]  # R^T e_z
+            self.gg = (
+                _to_fix(nu, P),
+                _to_fix(3 * nu * nu, P),
+                [_to_fix(a, P) for a in r0],
+                [_to_fix(a, P) for a in z0],
+            )
             imax = max(abs(I[i][j]) for i in range(3) for j in range(3))
             torque_bound += 3 * nu * nu * imax
         # characteristic angular rate: sets the scale of Omega for the error control
@@ -337,11 +342,13 @@ class _System:
                     f1 += A[1][0] * v0 + A[1][1] * v1 + A[1][2] * v2
                     f2 += A[2][0] * v0 + A[2][1] * v1 + A[2][2] * v2
                 # V' = V x W
-                new_aux.append((
-                    sum(map(mul, V1, rW2)) - sum(map(mul, V2, rW1)),
-                    sum(map(mul, V2, rW0)) - sum(map(mul, V0, rW2)),
-                    sum(map(mul, V0, rW1)) - sum(map(mul, V1, rW0)),
-                ))
+                new_aux.append(
+                    (
+                        sum(map(mul, V1, rW2)) - sum(map(mul, V2, rW1)),
+                        sum(map(mul, V2, rW0)) - sum(map(mul, V0, rW2)),
+                        sum(map(mul, V0, rW1)) - sum(map(mul, V1, rW0)),
+                    )
+                )
             if gg is not None:
                 R0, R1, R2 = r
                 Z0, Z1, Z2 = zb
@@ -459,8 +466,12 @@ def _rescale(groups, s, P):
 def _integrate(system, t_fix, N, log_eps, safety=0.85, stats=None):
     """Advance from t=0; return states (fixed) at the sorted fixed-point times t_fix (>= 0)."""
     P = system.P
-    state = (system.q0, system.w0, [a[0] for a in system.aux],
-             [system.gg[2], system.gg[3]] if system.gg is not None else [])
+    state = (
+        system.q0,
+        system.w0,
+        [a[0] for a in system.aux],
+        [system.gg[2], system.gg[3]] if system.gg is not None else [],
+    )
     t = 0
     results = []
     idx = 0
@@ -511,8 +522,20 @@ def _integrate(system, t_fix, N, log_eps, safety=0.85, stats=None):
     return results
 
 
-def reference_motion_mp(inertia, q0, omega0, t, *, gravity=None, gravity_gradient=None, body_torque=None,
-                        space_torque=None, dps=40, order=None, stats=None):
+def reference_motion_mp(
+    inertia,
+    q0,
+    omega0,
+    t,
+    *,
+    gravity=None,
+    gravity_gradient=None,
+    body_torque=None,
+    space_torque=None,
+    dps=40,
+    order=None,
+    stats=None,
+):
     """Like :func:`reference_motion` but returns lists of mpmath numbers at full working precision.
 
     Returns ``(q, omega)``: ``q[i]`` a list of 4 ``mpf`` and ``omega[i]`` a list of 3, for each
@@ -546,8 +569,9 @@ def reference_motion_mp(inertia, q0, omega0, t, *, gravity=None, gravity_gradien
     return q_out, w_out
 
 
-def reference_motion(inertia, q0, omega0, t, *, gravity=None, gravity_gradient=None, body_torque=None,
-                     space_torque=None, dps=40):
+def reference_motion(
+    inertia, q0, omega0, t, *, gravity=None, gravity_gradient=None, body_torque=None, space_torque=None, dps=40
+):
     """High-precision motion of a rigid body under torque.
 
     Parameters
@@ -575,8 +599,17 @@ def reference_motion(inertia, q0, omega0, t, *, gravity=None, gravity_gradient=N
         Attitude quaternions and body angular velocities, correctly rounded from the
         high-precision values (``q`` has unit norm to the working precision).
     """
-    q, w = reference_motion_mp(inertia, q0, omega0, t, gravity=gravity, gravity_gradient=gravity_gradient,
-                               body_torque=body_torque, space_torque=space_torque, dps=dps)
+    q, w = reference_motion_mp(
+        inertia,
+        q0,
+        omega0,
+        t,
+        gravity=gravity,
+        gravity_gradient=gravity_gradient,
+        body_torque=body_torque,
+        space_torque=space_torque,
+        dps=dps,
+    )
     qa = np.array([[float(a) for a in row] for row in q], dtype=float).reshape(-1, 4)
     wa = np.array([[float(a) for a in row] for row in w], dtype=float).reshape(-1, 3)
     return qa, wa
@@ -592,8 +625,7 @@ def _batched(fn):
         qa = np.asarray(q, dtype=object)
         if qa.ndim == 2:
             wa = np.asarray(omega, dtype=object)
-            return np.array([fn(inertia, qa[i], wa[i], *args, **kwargs) for i in range(qa.shape[0])],
-                            dtype=object)
+            return np.array([fn(inertia, qa[i], wa[i], *args, **kwargs) for i in range(qa.shape[0])], dtype=object)
         return fn(inertia, q, omega, *args, **kwargs)
 
     wrapper.__name__ = fn.__name__
@@ -693,7 +725,7 @@ def kovalevskaya_integral(inertia, q, omega, mass, c, g, *, dps=50):
         z = mpmath.mpc(w[0], w[1])
         xi = mpmath.mpc(gam[0], gam[1])
         val = z * z - kap * mpmath.mpc(cv[0], cv[1]) * xi
-        return +(val.real ** 2 + val.imag ** 2)
+        return +(val.real**2 + val.imag**2)
 
 
 @_batched
@@ -743,8 +775,7 @@ def jacobi_integral(inertia, q, omega, nu, t, *, dps=50):
     if qa.ndim == 2:
         wa = np.asarray(omega, dtype=object)
         ta = np.broadcast_to(np.asarray(t, dtype=object), (qa.shape[0],))
-        return np.array([_jacobi(inertia, qa[i], wa[i], nu, ta[i], dps=dps) for i in range(qa.shape[0])],
-                        dtype=object)
+        return np.array([_jacobi(inertia, qa[i], wa[i], nu, ta[i], dps=dps) for i in range(qa.shape[0])], dtype=object)
     return _jacobi(inertia, q, omega, nu, t, dps=dps)
 
 

@@ -66,9 +66,7 @@ INERTIA_KINDS = ("asymmetric", "prolate", "oblate", "sphere", "planar", "near_sy
 OMEGA_KINDS = ("uniform", "small", "near_axis", "near_separatrix")
 NEAR_IDENTITY_ANGLE = 1e-8
 NEAR_PI_OFFSET = 1e-7
-EULER_SEQUENCES = tuple(
-    a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b and b != c
-) + tuple(
+EULER_SEQUENCES = tuple(a + b + c for a in "xyz" for b in "xyz" for c in "xyz" if a != b and b != c) + tuple(
     (a + b + c).upper() for a in "xyz" for b in "xyz" for c in "xyz" if a != b and b != c
 )
 

@@ -51,8 +51,16 @@ def measure_dop853(I, M0, n_periods):
 
     up.direction = 1.0
     t_end = (n_periods + 1.2) * momentum_period(I, M0)  # only the span of the run
-    sol = solve_ivp(f, (0.0, t_end), np.concatenate([np.eye(3).ravel(), M0 / I]), method="DOP853",
-                    rtol=1e-12, atol=1e-14, events=up, dense_output=True)
+    sol = solve_ivp(
+        f,
+        (0.0, t_end),
+        np.concatenate([np.eye(3).ravel(), M0 / I]),
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-14,
+        events=up,
+        dense_output=True,
+    )
     te = sol.t_events[0]
     n = len(te) - 1
     assert n >= n_periods
@@ -68,8 +76,7 @@ def measure_exact(I, M0, n_periods):
     mid = int(np.argsort(I)[1])
     body = ep.RigidBody(I, allow_unphysical=True)
     T = momentum_period(I, M0)
-    tr = ep.solve(body, np.linspace(0.0, (n_periods + 1.2) * T, 200 * (n_periods + 2)), omega0=M0 / I,
-                  method="exact")
+    tr = ep.solve(body, np.linspace(0.0, (n_periods + 1.2) * T, 200 * (n_periods + 2)), omega0=M0 / I, method="exact")
     flips = flip_times(tr, component=mid)  # every half period
     n = (len(flips) - 1) // 2
     t0, t1 = flips[0], flips[2 * n]

@@ -22,8 +22,9 @@ def test_sleeping_top_threshold_and_nutation_frequency_match_simulation():
     eps = 1e-4
     q0 = ep.attitude.quaternion_from_axis_angle([1, 0, 0], eps)
     t = np.linspace(0, 20, 20001)
-    tr = ep.solve([I1, I1, I3], t, omega0=[0, 0, 15.0], attitude0=q0, torque=Gravity(MASS, [0, 0, ELL]),
-                  method="taylor")
+    tr = ep.solve(
+        [I1, I1, I3], t, omega0=[0, 0, 15.0], attitude0=q0, torque=Gravity(MASS, [0, 0, ELL]), method="taylor"
+    )
     tilt = _tilt(tr)
     assert tilt.max() < 1.2 * eps  # stays up
     x = tilt - tilt.mean()
@@ -40,8 +41,14 @@ def test_sleeping_top_below_threshold_falls(spin):
     assert not st["stable"] and st["growth_rate"] > 0
     q0 = ep.attitude.quaternion_from_axis_angle([1, 0, 0], 1e-6)
     T = 40.0 / st["growth_rate"]
-    tr = ep.solve([I1, I1, I3], np.linspace(0, T, 40001), omega0=[0, 0, spin], attitude0=q0,
-                  torque=Gravity(MASS, [0, 0, ELL]), method="taylor")
+    tr = ep.solve(
+        [I1, I1, I3],
+        np.linspace(0, T, 40001),
+        omega0=[0, 0, spin],
+        attitude0=q0,
+        torque=Gravity(MASS, [0, 0, ELL]),
+        method="taylor",
+    )
     # it leaves the vertical and swings down to the fall angle given by its integrals
     assert _tilt(tr).max() == pytest.approx(st["fall_angle"], rel=1e-3)
 
@@ -50,8 +57,14 @@ def test_sleeping_top_just_above_threshold_stays_up_and_hanging_top_is_always_st
     st = sleeping_top(I1, I3, MASS, ELL, spin=4.2)
     assert st["stable"]
     q0 = ep.attitude.quaternion_from_axis_angle([1, 0, 0], 1e-6)
-    tr = ep.solve([I1, I1, I3], np.linspace(0, 60, 601), omega0=[0, 0, 4.2], attitude0=q0,
-                  torque=Gravity(MASS, [0, 0, ELL]), method="taylor")
+    tr = ep.solve(
+        [I1, I1, I3],
+        np.linspace(0, 60, 601),
+        omega0=[0, 0, 4.2],
+        attitude0=q0,
+        torque=Gravity(MASS, [0, 0, ELL]),
+        method="taylor",
+    )
     assert _tilt(tr).max() < 1e-4
     assert sleeping_top(I1, I3, MASS, -ELL, spin=0.0)["stable"]
 
@@ -80,8 +93,7 @@ def test_gravity_gradient_small_oscillations_match_simulation():
 
     def relative_rotvec(axis):
         q0 = ep.attitude.quaternion_from_axis_angle(axis, 1e-4)
-        tr = ep.solve([Iy, Ir, Ip], T, omega0=[0, 0, nu], attitude0=q0, torque=GravityGradient(nu),
-                      method="taylor")
+        tr = ep.solve([Iy, Ir, Ip], T, omega0=[0, 0, nu], attitude0=q0, torque=GravityGradient(nu), method="taylor")
         rel = ep.attitude.quaternion_multiply(ep.attitude.quaternion_conjugate(q_orbit), tr.quaternion)
         return ep.attitude.rotvec_from_quaternion(rel)
 

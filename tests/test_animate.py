@@ -147,8 +147,9 @@ def test_html_structure_and_data(racket, tmp_path):
 
 
 def test_html_subsampling_and_escaping(racket, tmp_path):
-    tr = Trajectory(racket.t, racket.quaternion, racket.omega,
-                    RigidBody(RACKET_I, name="</script><b>x & y</b>"), method="m")
+    tr = Trajectory(
+        racket.t, racket.quaternion, racket.omega, RigidBody(RACKET_I, name="</script><b>x & y</b>"), method="m"
+    )
     out = tmp_path / "a.htm"
     an.animate(tr, out, max_samples=100)
     text = out.read_text()
@@ -175,11 +176,23 @@ def test_html_renders_in_headless_chromium(racket, tmp_path):
     page = tmp_path / "racket.html"
     an.animate(racket, page)
     shot = tmp_path / "shot.png"
-    cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-           "--disable-background-networking", "--disable-component-update", "--disable-sync",
-           "--enable-logging=stderr", "--v=0",
-           f"--user-data-dir={tmp_path / 'profile'}", f"--screenshot={shot}", "--window-size=800,600",
-           page.resolve().as_uri()]
+    cmd = [
+        browser,
+        "--headless",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--enable-logging=stderr",
+        "--v=0",
+        f"--user-data-dir={tmp_path / 'profile'}",
+        f"--screenshot={shot}",
+        "--window-size=800,600",
+        page.resolve().as_uri(),
+    ]
     try:
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=90)
     except subprocess.TimeoutExpired:

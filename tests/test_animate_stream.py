@@ -23,7 +23,7 @@ def _frames(n, w=64, h=48):
     out = []
     for k in range(n):
         f = np.full((h, w, 3), 255, np.uint8)
-        f[10:20, k % (w - 10):k % (w - 10) + 10] = (214, 39, 40)
+        f[10:20, k % (w - 10) : k % (w - 10) + 10] = (214, 39, 40)
         f[30:40, 5:15] = (31, 119, 180)
         out.append(f)
     return out

@@ -33,7 +33,9 @@ def test_one_unit_tolerance_for_quaternions_float32_accepted():
 
 
 def test_misspelled_keyword_is_an_argument_of_solve():
-    with pytest.raises(TypeError, match=r"solve\(\) got an unexpected keyword argument 'omgea0' \(did you mean 'omega0'\?\)"):
+    with pytest.raises(
+        TypeError, match=r"solve\(\) got an unexpected keyword argument 'omgea0' \(did you mean 'omega0'\?\)"
+    ):
         ep.solve([1, 2, 3], [1.0], omgea0=[1, 0, 0])
     with pytest.raises(TypeError, match="method 'exact' has no option 'tol' \\(an option of rk, taylor\\)"):
         ep.solve([1, 2, 3], [1.0], omega0=[1, 0, 0], tol=1e-9)
@@ -55,8 +57,9 @@ def test_trajectory_indexing_selection_and_evaluation():
     ref = ep.solve([1, 2, 3], [2.5, 7.25, -1.0], omega0=[1, 0.1, 0.5])
     assert np.max(quaternion_distance(mid.quaternion, ref.quaternion)) < 1e-14
     # from a later first sample, and under a time-dependent torque (the phase of the orbit continues)
-    gg = ep.solve([1, 1.7, 2.2], np.linspace(0, 6, 7), omega0=[0.1, 0, 0.5], torque=GravityGradient(0.7),
-                  method="taylor")
+    gg = ep.solve(
+        [1, 1.7, 2.2], np.linspace(0, 6, 7), omega0=[0.1, 0, 0.5], torque=GravityGradient(0.7), method="taylor"
+    )
     late = gg[2:]
     ev = late([3.5, 6.0])
     assert quaternion_distance(ev.quaternion[-1], gg.quaternion[-1]) < 1e-12
@@ -89,8 +92,7 @@ def test_taylor_in_long_double_and_mpmath_rounds_once_to_the_closed_form():
     with pytest.raises(InvalidInputError, match="precision must be one of float64, longdouble, mpmath"):
         ep.solve([1, 2, 3], [1.0], omega0=w0, method="taylor", precision="quad")
     with pytest.raises(InvalidInputError, match="precision='longdouble' is for the free body"):
-        ep.solve([1, 2, 3], [1.0], omega0=w0, method="taylor", precision="longdouble",
-                 torque=GravityGradient(0.1))
+        ep.solve([1, 2, 3], [1.0], omega0=w0, method="taylor", precision="longdouble", torque=GravityGradient(0.1))
 
 
 def test_long_double_input_is_kept_or_its_rounding_said():
@@ -104,8 +106,24 @@ def test_long_double_input_is_kept_or_its_rounding_said():
 def test_precision_from_the_command_line(capsys):
     from eulerpoisson.cli import main
 
-    code = main(["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "5", "--method", "taylor",
-                 "--precision", "longdouble", "--tol", "2e-19", "--json"])
+    code = main(
+        [
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0.1,0.5",
+            "--t-end",
+            "5",
+            "--method",
+            "taylor",
+            "--precision",
+            "longdouble",
+            "--tol",
+            "2e-19",
+            "--json",
+        ]
+    )
     out, err = capsys.readouterr()
     assert code == 0, err
     import json

@@ -41,9 +41,7 @@ def qdist(q1, q2):
 def np_quat_mul(p, q):
     pw, pv = p[..., :1], p[..., 1:]
     qw, qv = q[..., :1], q[..., 1:]
-    return np.concatenate(
-        [pw * qw - np.sum(pv * qv, -1, keepdims=True), pw * qv + qw * pv + np.cross(pv, qv)], -1
-    )
+    return np.concatenate([pw * qw - np.sum(pv * qv, -1, keepdims=True), pw * qv + qw * pv + np.cross(pv, qv)], -1)
 
 
 def scipy_rot(q):
@@ -201,7 +199,9 @@ def test_matrix_from_gibbs_is_eq_1_9_and_eq_1_7(ka):
     eps3 = np.zeros((3, 3, 3))
     for i, j, l in itertools.permutations(range(3)):
         eps3[i, j, l] = np.linalg.det(np.eye(3)[[i, j, l]])
-    lit = ((1 - n2) * np.eye(3) + 2 * n[..., :, None] * n[..., None, :] - 2 * np.einsum("ijk,...k->...ij", eps3, n)) / (1 + n2)
+    lit = ((1 - n2) * np.eye(3) + 2 * n[..., :, None] * n[..., None, :] - 2 * np.einsum("ijk,...k->...ij", eps3, n)) / (
+        1 + n2
+    )
     np.testing.assert_allclose(R, lit, atol=1e-15 * (1 + float(np.max(np.abs(n)))))
     np.testing.assert_allclose(np.swapaxes(R, -1, -2) @ R, np.broadcast_to(np.eye(3), R.shape), atol=2e-15)
     np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=2e-15)
@@ -462,8 +462,15 @@ def test_euler_gimbal_lock_round_trip(seq):
 
 @pytest.mark.parametrize(
     "bad, msg",
-    [("xy", "3-letter"), (123, "3-letter"), ("xYz", "mixes lower case"), ("xxy", "consecutive"),
-     ("xyy", "consecutive"), ("abc", "only contain"), ("", "3-letter")],
+    [
+        ("xy", "3-letter"),
+        (123, "3-letter"),
+        ("xYz", "mixes lower case"),
+        ("xxy", "consecutive"),
+        ("xyy", "consecutive"),
+        ("abc", "only contain"),
+        ("", "3-letter"),
+    ],
 )
 def test_euler_sequence_errors(bad, msg):
     with pytest.raises(InvalidInputError, match=msg):
@@ -497,7 +504,9 @@ def test_gibbs_compose_is_matrix_product(data, shape):
     b = Attitude.from_gibbs(n1) @ Attitude.from_gibbs(n2)
     np.testing.assert_allclose(b.as_matrix(), R12, atol=1e-14)
     # inverse
-    np.testing.assert_allclose(at.matrix_from_gibbs(at.gibbs_inverse(n1)), np.swapaxes(at.matrix_from_gibbs(n1), -1, -2), atol=0)
+    np.testing.assert_allclose(
+        at.matrix_from_gibbs(at.gibbs_inverse(n1)), np.swapaxes(at.matrix_from_gibbs(n1), -1, -2), atol=0
+    )
     np.testing.assert_allclose(at.gibbs_compose(n1, at.gibbs_inverse(n1)), 0.0, atol=0)
 
 
@@ -574,7 +583,9 @@ def test_omega_from_gibbs_rate_vs_finite_difference(n, rng):
     # the two maps of eq. 1.11 and eq. 1.30 are inverse to each other
     np.testing.assert_allclose(om, omega, atol=1e-13 * (1 + nn.max()) ** 2)
     # Omega = 2 A^T ndot literally
-    np.testing.assert_allclose(om, 2 * np.einsum("...ji,...j->...i", at.conversion_matrix(n), nd), rtol=1e-14, atol=1e-14)
+    np.testing.assert_allclose(
+        om, 2 * np.einsum("...ji,...j->...i", at.conversion_matrix(n), nd), rtol=1e-14, atol=1e-14
+    )
 
 
 def test_omega_from_gibbs_rate_closed_form():

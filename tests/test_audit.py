@@ -59,10 +59,22 @@ def test_every_numbered_equation_has_a_computed_status(report):
         assert eqs[label].status in A.STATUSES
         assert eqs[label].checks, f"equation {label} has no checks"
     # the prose claims requested in the task are there too
-    for label in ("before 1.8", "footnote 1.9", "after 1.12", "after 1.13 (n -> 0)", "after 1.13 (n -> infinity)",
-                  "footnote 1.13", "footnote 1.16.1", "footnote 1.20", "after 1.21 (antisymmetry)",
-                  "after 1.21 (nondegenerate)", "after 1.21 (no Casimir)", "after 1.23 (involution)",
-                  "after 1.21 (e(3))", "after 1.17"):
+    for label in (
+        "before 1.8",
+        "footnote 1.9",
+        "after 1.12",
+        "after 1.13 (n -> 0)",
+        "after 1.13 (n -> infinity)",
+        "footnote 1.13",
+        "footnote 1.16.1",
+        "footnote 1.20",
+        "after 1.21 (antisymmetry)",
+        "after 1.21 (nondegenerate)",
+        "after 1.21 (no Casimir)",
+        "after 1.23 (involution)",
+        "after 1.21 (e(3))",
+        "after 1.17",
+    ):
         assert label in eqs
 
 
@@ -87,8 +99,14 @@ def test_labels_match_paper_source():
 def test_known_verdicts(report):
     """Verdicts against hand analysis of the paper (see the report for the computations)."""
     misprints = {e.equation for e in report.entries if e.status == "misprint"}
-    assert misprints == {"before 1.8", "1.12", "after 1.13 (n -> 0)", "after 1.13 (n -> infinity)", "1.16",
-                         "footnote 1.16.1"}
+    assert misprints == {
+        "before 1.8",
+        "1.12",
+        "after 1.13 (n -> 0)",
+        "after 1.13 (n -> infinity)",
+        "1.16",
+        "footnote 1.16.1",
+    }
     assert report.entry("1.1").status == "not-checkable"
     assert report.entry("1.15.1").status == "not-checkable"
     for eq in ("1.9", "1.13", "1.17", "1.19", "1.21", "1.23", "1.28", "1.29", "1.30", "1.23.1"):
@@ -186,8 +204,17 @@ def test_json_schema(report):
     data = json.loads(report.to_json())
     assert set(data) >= {"summary", "entries", "integrability", "meta", "elapsed_s"}
     assert len(data["entries"]) == len(A.ENTRIES)
-    required = {"equation": str, "status": str, "printed": str, "derived": str, "note": str, "title": str,
-                "context": str, "inertia": str, "method": str}
+    required = {
+        "equation": str,
+        "status": str,
+        "printed": str,
+        "derived": str,
+        "note": str,
+        "title": str,
+        "context": str,
+        "inertia": str,
+        "method": str,
+    }
     for e in data["entries"]:
         for key, typ in required.items():
             assert isinstance(e[key], typ), (e.get("equation"), key)
@@ -235,7 +262,10 @@ def test_latex_document_structure_and_compiles(report, tmp_path):
     (tmp_path / "audit.tex").write_text(tex)
     proc = subprocess.run(
         ["pdflatex", "-interaction=nonstopmode", "-halt-on-error", "audit.tex"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=240,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=240,
     )
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert (tmp_path / "audit.pdf").stat().st_size > 10000

@@ -53,8 +53,18 @@ def test_work_precision_schema_and_png(quick_run):
     assert d["problem"]["inertia"] == [1.0, 2.0, 3.0]
     assert d["reference"]["source"]
     names = {c["name"] for c in d["curves"]}
-    expected = {"exact", "taylor", "symplectic-splitting", "symplectic-splitting4", "symplectic-gauss4",
-                "symplectic-gauss6", "rk-DOP853", "rk-RK45", "scipy-DOP853", "scipy-RK45"}
+    expected = {
+        "exact",
+        "taylor",
+        "symplectic-splitting",
+        "symplectic-splitting4",
+        "symplectic-gauss4",
+        "symplectic-gauss6",
+        "rk-DOP853",
+        "rk-RK45",
+        "scipy-DOP853",
+        "scipy-RK45",
+    }
     assert expected <= names
     for c in d["curves"]:
         assert c["label"] and c["knob"] in ("none", "tol", "rtol", "dt")
@@ -92,8 +102,15 @@ def test_long_run_schema(quick_run):
 def test_throughput_schema(quick_run):
     d = _load(quick_run, "throughput")
     rows = {r["name"]: r for r in d["rows"]}
-    assert {"exact_solve", "exact_kernel", "taylor_batch", "symplectic_splitting", "symplectic_splitting4",
-            "symplectic_gauss4", "scipy_ellipj"} <= set(rows)
+    assert {
+        "exact_solve",
+        "exact_kernel",
+        "taylor_batch",
+        "symplectic_splitting",
+        "symplectic_splitting4",
+        "symplectic_gauss4",
+        "scipy_ellipj",
+    } <= set(rows)
     for r in rows.values():
         assert _pos(r["value"]) and r["unit"]
 
@@ -112,8 +129,12 @@ def test_fit_schema(quick_run):
 def test_cold_start_schema(quick_run):
     d = _load(quick_run, "cold_start")
     rows = {r["name"]: r for r in d["rows"]}
-    assert {"import_eulerpoisson", "cli_simulate_warm", "cli_simulate_warm_nopyc",
-            "cli_first_simulate_after_warmup"} <= set(rows)
+    assert {
+        "import_eulerpoisson",
+        "cli_simulate_warm",
+        "cli_simulate_warm_nopyc",
+        "cli_first_simulate_after_warmup",
+    } <= set(rows)
     for r in rows.values():
         assert _pos(r["value"]) and r["unit"] == "s" and r["runs"] >= 1
     goals = [g for g in _load(quick_run, "goals")["goals"] if g["goal"].startswith("cold start")]

@@ -35,8 +35,17 @@ def test_simulate_json_keys_and_values(capsys):
 
 def test_simulate_full_tensor_gibbs_and_m(capsys):
     code, out, err = run(
-        capsys, "simulate", "--inertia", "2,0.1,0,0.1,3,0,0,0,4", "--m", "0.5,1,0.2",
-        "--gibbs", "0.1,0.2,0.3", "--t-end", "3", "--json",
+        capsys,
+        "simulate",
+        "--inertia",
+        "2,0.1,0,0.1,3,0,0,0,4",
+        "--m",
+        "0.5,1,0.2",
+        "--gibbs",
+        "0.1,0.2,0.3",
+        "--t-end",
+        "3",
+        "--json",
     )
     assert code == 0, err
     d = json.loads(out)
@@ -45,8 +54,20 @@ def test_simulate_full_tensor_gibbs_and_m(capsys):
 
 def test_simulate_writes_netcdf_and_info(capsys, tmp_path):
     path = tmp_path / "run.nc"
-    code, out, err = run(capsys, "simulate", "--inertia", "3,5,8", "--omega", "0,0.4,0.001", "--t-end", "20",
-                         "--samples", "50", "--out", str(path))
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "3,5,8",
+        "--omega",
+        "0,0.4,0.001",
+        "--t-end",
+        "20",
+        "--samples",
+        "50",
+        "--out",
+        str(path),
+    )
     assert code == 0, err
     assert path.exists() and "wrote" in out
     code, out, err = run(capsys, "info", str(path))
@@ -74,13 +95,22 @@ def test_simulate_toml_and_flag_override(capsys, tmp_path):
         (["simulate", "--inertia", "1,2", "--omega", "1,0,0", "--t-end", "1"], "expected 3 or 9 numbers"),
         (["simulate", "--inertia", "1,1,3", "--omega", "1,0,0", "--t-end", "1"], "triangle inequality"),
         (["simulate", "--inertia", "1,2,3,4,5,6,7,8,9", "--omega", "1,0,0", "--t-end", "1"], "not symmetric"),
-        (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--quaternion", "1,1,0,0", "--t-end", "1"], "unit quaternion"),
+        (
+            ["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--quaternion", "1,1,0,0", "--t-end", "1"],
+            "unit quaternion",
+        ),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "inf"], "t-end must be a finite number"),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,nan", "--t-end", "1"], "finite"),
-        (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--method", "magic"], "unknown method 'magic'"),
+        (
+            ["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--method", "magic"],
+            "unknown method 'magic'",
+        ),
         (["simulate", "--inertia", "1,2,3", "--t-end", "1"], "exactly one initial condition"),
         (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0"], "--t-end"),
-        (["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--samples", "1"], "samples must be an integer >= 2"),
+        (
+            ["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--samples", "1"],
+            "samples must be an integer >= 2",
+        ),
         (["simulate", "--bogus"], "unrecognized arguments: --bogus"),
         (["simulate", "missing.toml"], "does not exist"),
         (["info", "missing.nc"], "no such file"),
@@ -124,8 +154,12 @@ def test_version_and_help(capsys):
 
 def test_console_script_entry_point(tmp_path):
     exe = os.path.join(os.path.dirname(sys.executable), "eulerpoisson")
-    res = subprocess.run([exe, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "nan"],
-                         capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [exe, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "nan"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 2
     assert len(res.stderr.strip().splitlines()) == 1
 
@@ -153,8 +187,21 @@ def test_sweep_and_atlas_plot(capsys, tmp_path):
 
 def test_simulate_streams_to_zarr(capsys, tmp_path):
     store = tmp_path / "r.zarr"
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10",
-                         "--samples", "1001", "--out", str(store), "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "10",
+        "--samples",
+        "1001",
+        "--out",
+        str(store),
+        "--json",
+    )
     assert code == 0, err
     import xarray as xr
 
@@ -162,8 +209,9 @@ def test_simulate_streams_to_zarr(capsys, tmp_path):
     assert ds["quaternion"].shape == (1001, 4)
     last = json.loads(out)
     np.testing.assert_allclose(ds["omega"].values[-1], last["omega"], atol=1e-15)
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
-                         "--out", str(tmp_path / "r.txt"))
+    code, out, err = run(
+        capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--out", str(tmp_path / "r.txt")
+    )
     assert code == 2 and ".nc (NetCDF) or .zarr" in err
 
 
@@ -172,8 +220,23 @@ def test_long_simulate_works_in_chunks(capsys, tmp_path):
 
     n = CHUNKED_SAMPLES + 1
     path = tmp_path / "long.nc"
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "50",
-                         "--samples", str(n), "--method", "taylor", "--out", str(path), "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "50",
+        "--samples",
+        str(n),
+        "--method",
+        "taylor",
+        "--out",
+        str(path),
+        "--json",
+    )
     assert code == 0, err
     assert err == ""  # no progress bar without a terminal
     tr = ep.Trajectory.from_netcdf(path)

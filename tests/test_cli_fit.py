@@ -88,15 +88,18 @@ def good_rows():
     return np.column_stack([t, tr.quaternion, tr.omega])
 
 
-@pytest.mark.parametrize("kind,match", [
-    ("missing", r"no such file"),
-    ("no_t", r"\bt\b"),
-    ("unsorted", r"(?i)increasing|sorted"),
-    ("duplicate", r"(?i)duplicate"),
-    ("nonunit", r"(?i)unit"),
-    ("few", r"(?i)too few observations"),
-    ("text", r"(?i)not a number|numeric|row"),
-])
+@pytest.mark.parametrize(
+    "kind,match",
+    [
+        ("missing", r"no such file"),
+        ("no_t", r"\bt\b"),
+        ("unsorted", r"(?i)increasing|sorted"),
+        ("duplicate", r"(?i)duplicate"),
+        ("nonunit", r"(?i)unit"),
+        ("few", r"(?i)too few observations"),
+        ("text", r"(?i)not a number|numeric|row"),
+    ],
+)
 def test_bad_files_are_one_line_and_exit_2(capsys, tmp_path, good_rows, kind, match):
     rows = good_rows.copy()
     header = "t,qw,qx,qy,qz,wx,wy,wz"
@@ -131,8 +134,9 @@ def test_existing_outputs_need_overwrite(capsys, tmp_path, good_rows):
     code, out, err = run(capsys, "fit", obs, "--out", str(out_json))
     assert code == 2 and "--overwrite" in err
     assert out_json.read_text() == "{}"
-    code, out, err = run(capsys, "fit", obs, "--out", str(out_json), "--overwrite", "--sigma-attitude", "0.01",
-                         "--sigma-omega", "1e-5")
+    code, out, err = run(
+        capsys, "fit", obs, "--out", str(out_json), "--overwrite", "--sigma-attitude", "0.01", "--sigma-omega", "1e-5"
+    )
     assert code == 0, err
     d = json.loads(out_json.read_text())
     assert np.allclose(np.diag(d["inertia"]), np.array([0.25, 0.33, 0.42]) / 1.0, atol=1e-8)
@@ -145,13 +149,16 @@ def test_existing_outputs_need_overwrite(capsys, tmp_path, good_rows):
     assert code == 2 and "--overwrite" in err and "fit.png" in err
 
 
-@pytest.mark.parametrize("argv,match", [
-    (["--sigma-omega", "-1"], r"--sigma-omega must be a positive"),
-    (["--sigma-attitude", "x"], r"--sigma-attitude: 'x' is not a number"),
-    (["--principal-axes", "free"], r"invalid choice"),
-    (["--inertia", "1,2"], r"--inertia must be three"),
-    (["--axis", "1,0"], r"--axis must be three"),
-])
+@pytest.mark.parametrize(
+    "argv,match",
+    [
+        (["--sigma-omega", "-1"], r"--sigma-omega must be a positive"),
+        (["--sigma-attitude", "x"], r"--sigma-attitude: 'x' is not a number"),
+        (["--principal-axes", "free"], r"invalid choice"),
+        (["--inertia", "1,2"], r"--inertia must be three"),
+        (["--axis", "1,0"], r"--axis must be three"),
+    ],
+)
 def test_bad_options(capsys, tmp_path, good_rows, argv, match):
     obs = _write(tmp_path / "obs.csv", _csv(good_rows))
     code, out, err = run(capsys, "fit", obs, *argv)
@@ -178,6 +185,9 @@ def test_example_script_fits_and_predicts(tmp_path, capsys):
     assert "prediction from t <= 0.3 s" in out and "sigma apart" in out
     assert (tmp_path / "phone_fit" / "prediction.png").stat().st_size > 0
     for name in ("phone_toss_1", "phone_toss_2"):
-        assert sorted(p.name for p in (tmp_path / "phone_fit" / name).iterdir()) == \
-            ["fit.png", "polhode.png", "residuals.png"]
+        assert sorted(p.name for p in (tmp_path / "phone_fit" / name).iterdir()) == [
+            "fit.png",
+            "polhode.png",
+            "residuals.png",
+        ]
         assert results[name].converged

@@ -35,7 +35,7 @@ def one_error(capsys, argv, match):
     assert len(lines) == 1, err
     assert "Traceback" not in err
     assert lines[0].startswith("eulerpoisson: error: "), lines[0]  # every error line starts the same way
-    msg = lines[0][len("eulerpoisson: error: "):]
+    msg = lines[0][len("eulerpoisson: error: ") :]
     assert re.search(match, lines[0]) or re.search(match, msg), lines[0]
     assert out == ""
     return lines[0]
@@ -75,8 +75,10 @@ def test_conflicting_flags_are_errors(capsys, extra, match):
     "initial, match",
     [
         ("omega = [1, 0.1, 0.5]\nm = [1, 0, 0]", r"run\.toml: give exactly one of \[initial\] omega and \[initial\] m"),
-        ("omega = [1, 0.1, 0.5]\nquaternion = [1, 0, 0, 0]\ngibbs = [0, 0, 1]",
-         r"run\.toml: give at most one of \[initial\] quaternion and \[initial\] gibbs"),
+        (
+            "omega = [1, 0.1, 0.5]\nquaternion = [1, 0, 0, 0]\ngibbs = [0, 0, 1]",
+            r"run\.toml: give at most one of \[initial\] quaternion and \[initial\] gibbs",
+        ),
     ],
 )
 def test_self_contradicting_file_is_an_error_even_with_a_flag(capsys, tmp_path, initial, match):
@@ -113,15 +115,29 @@ def test_toml_output_json_is_honoured(capsys, tmp_path):
     cfg = toml(tmp_path, GOOD + "[output]\njson = false\n", name="nojson.toml")
     code, out, err = run(capsys, "simulate", cfg)
     assert code == 0 and out.startswith("exact:")
-    one_error(capsys, ["simulate", toml(tmp_path, GOOD + "[output]\njson = 1\n", name="j.toml")],
-              r"j\.toml: \[output\] json must be true or false, got 1")
+    one_error(
+        capsys,
+        ["simulate", toml(tmp_path, GOOD + "[output]\njson = 1\n", name="j.toml")],
+        r"j\.toml: \[output\] json must be true or false, got 1",
+    )
 
 
 def test_toml_3x3_inertia_table_equals_nine_numbers(capsys, tmp_path):
     table = GOOD.replace("inertia = [1, 2, 3]", "inertia = [[2, 0.1, 0], [0.1, 3, 0], [0, 0, 4]]")
     a = ok_json(capsys, "simulate", toml(tmp_path, table), "--json")
-    b = ok_json(capsys, "simulate", "--inertia", "2,0.1,0,0.1,3,0,0,0,4", "--omega", "1,0.1,0.5",
-                "--t-end", "1", "--samples", "3", "--json")
+    b = ok_json(
+        capsys,
+        "simulate",
+        "--inertia",
+        "2,0.1,0,0.1,3,0,0,0,4",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "1",
+        "--samples",
+        "3",
+        "--json",
+    )
     assert a["quaternion"] == b["quaternion"] and a["omega"] == b["omega"]
 
 
@@ -135,9 +151,21 @@ def test_toml_integer_order_is_used(capsys, tmp_path):
 @pytest.mark.parametrize(
     "old, new, match",
     [
-        ("samples = 3", 'samples = 3\n[method]\nname = "taylor"\norder = true', r"\[method\] order must be an integer, got true"),
-        ("samples = 3", 'samples = 3\n[method]\nname = "taylor"\norder = 7.9', r"\[method\] order must be an integer, got 7\.9"),
-        ("samples = 3", 'samples = 3\n[method]\nname = "taylor"\norder = "abc"', r"\[method\] order must be an integer, got \"abc\""),
+        (
+            "samples = 3",
+            'samples = 3\n[method]\nname = "taylor"\norder = true',
+            r"\[method\] order must be an integer, got true",
+        ),
+        (
+            "samples = 3",
+            'samples = 3\n[method]\nname = "taylor"\norder = 7.9',
+            r"\[method\] order must be an integer, got 7\.9",
+        ),
+        (
+            "samples = 3",
+            'samples = 3\n[method]\nname = "taylor"\norder = "abc"',
+            r"\[method\] order must be an integer, got \"abc\"",
+        ),
         ("samples = 3", "samples = 3.9", r"\[time\] samples must be an integer, got 3\.9"),
         ("samples = 3", "samples = 8.0", r"\[time\] samples must be an integer, got 8\.0"),
         ("samples = 3", 'samples = "7"', r"\[time\] samples must be an integer"),
@@ -156,9 +184,17 @@ def test_toml_integer_order_is_used(capsys, tmp_path):
         ("[time]", "name = [1, 2]\n[time]", r"unknown key\(s\) name in \[initial\]"),
         ("inertia = [1, 2, 3]", "inertia = [1, 2, 3]\nname = [1, 2]", r"\[body\] name must be a string, got \[1, 2\]"),
         ("samples = 3", "samples = 3\n[method]\nname = 5", r"\[method\] name must be a string, got 5"),
-        ("samples = 3", 'samples = 3\n[method]\nname = "rk"\nintegrator = 5', r"\[method\] integrator must be a string"),
+        (
+            "samples = 3",
+            'samples = 3\n[method]\nname = "rk"\nintegrator = 5',
+            r"\[method\] integrator must be a string",
+        ),
         ("samples = 3", 'samples = 3\n[method]\nname = "rk"\nrtol = -1', r"\[method\] rtol must be a positive number"),
-        ("samples = 3", 'samples = 3\n[method]\nname = "rk"\ntol = false', r"\[method\] tol must be a number, got false"),
+        (
+            "samples = 3",
+            'samples = 3\n[method]\nname = "rk"\ntol = false',
+            r"\[method\] tol must be a number, got false",
+        ),
         ("samples = 3", "samples = 3\n[output]\nfile = 5", r"\[output\] file must be a string, got 5"),
         ("samples = 3", 'samples = 3\n[output]\nfile = ""', r"\[output\] file: empty file name"),
     ],
@@ -175,8 +211,10 @@ def test_toml_values_are_checked_and_named(capsys, tmp_path, old, new, match):
     [
         ('masses = "abc"\npositions = [[0,0,0],[1,0,0],[0,1,0]]', r"\[body\] masses must be a list of numbers"),
         ("masses = [1, 1, 1]\npositions = [[0,0,0],[1,0],[0,1,0]]", r"\[body\] positions must be a list of points"),
-        ("masses = [1, 1, 1]\npositions = [[0,0,0],[1,0,0]]",
-         r"run\.toml: \[body\] masses has 3 entries but \[body\] positions has 2 points"),
+        (
+            "masses = [1, 1, 1]\npositions = [[0,0,0],[1,0,0]]",
+            r"run\.toml: \[body\] masses has 3 entries but \[body\] positions has 2 points",
+        ),
     ],
 )
 def test_toml_point_masses_are_checked(capsys, tmp_path, body, match):
@@ -202,7 +240,10 @@ def test_config_that_is_a_directory_or_empty_name(capsys, tmp_path):
 @pytest.mark.parametrize(
     "exc, match",
     [
-        (MemoryError("Unable to allocate 745. GiB"), r"^eulerpoisson: error: out of memory: Unable to allocate 745\. GiB$"),
+        (
+            MemoryError("Unable to allocate 745. GiB"),
+            r"^eulerpoisson: error: out of memory: Unable to allocate 745\. GiB$",
+        ),
         (OverflowError(34, "Numerical result out of range"), r"^eulerpoisson: error: numerical overflow: "),
         (ZeroDivisionError("float division by zero"), r"^eulerpoisson: error: float division by zero$"),
         (KeyError("no variable named 'inertia'"), r"^eulerpoisson: error: no variable named 'inertia'$"),
@@ -246,8 +287,11 @@ def test_warnings_do_not_reach_stderr(capsys, monkeypatch):
 
 
 def test_real_overflow_is_one_line(capsys):
-    one_error(capsys, ["simulate", "--inertia", "1,2,3", "--omega", "1e200,0.1,0.5", "--t-end", "1"],
-              r"^eulerpoisson: error: ")
+    one_error(
+        capsys,
+        ["simulate", "--inertia", "1,2,3", "--omega", "1e200,0.1,0.5", "--t-end", "1"],
+        r"^eulerpoisson: error: ",
+    )
 
 
 def test_debug_shows_warnings(capsys, monkeypatch):
@@ -282,18 +326,46 @@ def test_debug_after_subcommand_raises_the_error():
 # 6. values that begin with '-'
 # ---------------------------------------------------------------------------
 def test_negative_vectors_are_values(capsys):
-    d = ok_json(capsys, "simulate", "--inertia", "1,2,3", "--omega", "-1,0.1,0.5", "--quaternion", "-0.6,0,0.8,0",
-                "--t-end", "2", "--samples", "3", "--json")
+    d = ok_json(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "-1,0.1,0.5",
+        "--quaternion",
+        "-0.6,0,0.8,0",
+        "--t-end",
+        "2",
+        "--samples",
+        "3",
+        "--json",
+    )
     ref = ep.solve([1, 2, 3], [0.0, 2.0], omega0=[-1, 0.1, 0.5], attitude0=[-0.6, 0, 0.8, 0])
     np.testing.assert_allclose(d["omega"], ref.omega[-1], atol=1e-13)
     np.testing.assert_allclose(abs(np.dot(d["quaternion"], ref.quaternion[-1])), 1.0, atol=1e-13)
-    d = ok_json(capsys, "simulate", "--inertia", "1,2,3", "--m", "-0.5,1,-0.2", "--gibbs", "-0.1,0.2,-0.3",
-                "--t-end", "0", "--samples", "2", "--json")
+    d = ok_json(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--m",
+        "-0.5,1,-0.2",
+        "--gibbs",
+        "-0.1,0.2,-0.3",
+        "--t-end",
+        "0",
+        "--samples",
+        "2",
+        "--json",
+    )
     np.testing.assert_allclose(d["m"], [-0.5, 1.0, -0.2], atol=1e-13)
     q = np.array(d["quaternion"])
     np.testing.assert_allclose(q[1:] / q[0], [-0.1, 0.2, -0.3], rtol=1e-13)
     # an abbreviated option works too (argparse allows unique prefixes)
-    d2 = ok_json(capsys, "simulate", "--inertia", "1,2,3", "--ome", "-1,0.1,0.5", "--t-end", "2", "--samples", "3", "--json")
+    d2 = ok_json(
+        capsys, "simulate", "--inertia", "1,2,3", "--ome", "-1,0.1,0.5", "--t-end", "2", "--samples", "3", "--json"
+    )
     np.testing.assert_allclose(d2["omega"], ref.omega[-1], atol=1e-13)
 
 
@@ -318,7 +390,11 @@ def test_negative_scalars_reach_their_checks(capsys, flag, value, match):
 def test_prepare_argv_glues_only_value_options():
     parser = cli.build_parser()
     prep = cli._prepare_argv
-    assert prep(["simulate", "--omega", "-1,2,3", "--debug", "--json"], parser) == ["simulate", "--omega=-1,2,3", "--json"]
+    assert prep(["simulate", "--omega", "-1,2,3", "--debug", "--json"], parser) == [
+        "simulate",
+        "--omega=-1,2,3",
+        "--json",
+    ]
     assert prep(["simulate", "--json", "-1"], parser) == ["simulate", "--json", "-1"]  # a flag takes no value
     assert prep(["simulate", "--omega", "--json"], parser) == ["simulate", "--omega", "--json"]
     assert prep(["simulate", "--omega", "-h"], parser) == ["simulate", "--omega", "-h"]  # a known option
@@ -503,9 +579,11 @@ def bad_files(tmp_path_factory):
 @pytest.mark.parametrize("command", ["info", "plot", "animate"])
 def test_malformed_trajectory_is_one_line_naming_the_file(capsys, tmp_path, bad_files, kind, command):
     path = bad_files[kind]
-    argv = {"info": ["info", path],
-            "plot": ["plot", path, "--kind", "omega", "--out", str(tmp_path / "p.png")],
-            "animate": ["animate", path, "--out", str(tmp_path / "m.html")]}[command]
+    argv = {
+        "info": ["info", path],
+        "plot": ["plot", path, "--kind", "omega", "--out", str(tmp_path / "p.png")],
+        "animate": ["animate", path, "--out", str(tmp_path / "m.html")],
+    }[command]
     one_error(capsys, argv, re.escape(f"{kind}.nc"))
     assert list(tmp_path.iterdir()) == []
 
@@ -518,8 +596,11 @@ def test_reader_errors_get_the_file_name(capsys, tmp_path, monkeypatch):
         raise KeyError("No variable named 'inertia'")
 
     monkeypatch.setattr(ep.Trajectory, "from_netcdf", staticmethod(broken))
-    one_error(capsys, ["info", str(path)],
-              r"^eulerpoisson: error: .*t\.nc: not a valid eulerpoisson trajectory file: No variable named 'inertia'$")
+    one_error(
+        capsys,
+        ["info", str(path)],
+        r"^eulerpoisson: error: .*t\.nc: not a valid eulerpoisson trajectory file: No variable named 'inertia'$",
+    )
 
     def named(p):
         raise EulerPoissonError(f"{p}: attribute x is wrong")

@@ -20,12 +20,24 @@ def run(capsys, *argv):
 def test_allow_unphysical_flag_and_toml_key(capsys, tmp_path):
     code, out, err = run(capsys, "simulate", "--inertia", "3,5,9", "--omega", "0,0.4,0.001", "--t-end", "1")
     assert code == 2 and "allow_unphysical" in err or "triangle" in err
-    code, out, err = run(capsys, "simulate", "--inertia", "3,5,9", "--omega", "0,0.4,0.001", "--t-end", "1",
-                         "--allow-unphysical", "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "3,5,9",
+        "--omega",
+        "0,0.4,0.001",
+        "--t-end",
+        "1",
+        "--allow-unphysical",
+        "--json",
+    )
     assert code == 0 and '"t": 1.0' in out
     cfg = tmp_path / "r.toml"
-    cfg.write_text('[body]\ninertia = [3, 5, 9]\nallow_unphysical = true\n[initial]\nomega = [0, 0.4, 0.001]\n'
-                   '[time]\nt_end = 1.0\n')
+    cfg.write_text(
+        "[body]\ninertia = [3, 5, 9]\nallow_unphysical = true\n[initial]\nomega = [0, 0.4, 0.001]\n"
+        "[time]\nt_end = 1.0\n"
+    )
     code, out, err = run(capsys, "simulate", str(cfg), "--json")
     assert code == 0, err
 
@@ -33,8 +45,9 @@ def test_allow_unphysical_flag_and_toml_key(capsys, tmp_path):
 def test_negative_t_end_runs_backwards(capsys):
     import json
 
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "-5",
-                         "--samples", "11", "--json")
+    code, out, err = run(
+        capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "-5", "--samples", "11", "--json"
+    )
     assert code == 0, err
     state = json.loads(out)
     ref = ep.solve([1, 2, 3], [-5.0], omega0=[1, 0.1, 0.5])
@@ -43,23 +56,71 @@ def test_negative_t_end_runs_backwards(capsys):
 
 
 def test_every_method_option_is_a_flag(capsys):
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
-                         "--method", "rk", "--integrator", "RK45", "--rtol", "1e-9", "--atol", "1e-12", "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "2",
+        "--method",
+        "rk",
+        "--integrator",
+        "RK45",
+        "--rtol",
+        "1e-9",
+        "--atol",
+        "1e-12",
+        "--json",
+    )
     assert code == 0, err
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
-                         "--method", "taylor", "--order", "12", "--max-steps", "100000", "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "2",
+        "--method",
+        "taylor",
+        "--order",
+        "12",
+        "--max-steps",
+        "100000",
+        "--json",
+    )
     assert code == 0, err
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2",
-                         "--method", "taylor", "--integrator", "RK45")
-    assert code == 2 and err.strip().endswith("--integrator is not an option of method 'taylor' "
-                                              "(its options: --chart-threshold, --dps, --dt, --max-steps, --order, --precision, --tol)")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "2",
+        "--method",
+        "taylor",
+        "--integrator",
+        "RK45",
+    )
+    assert code == 2 and err.strip().endswith(
+        "--integrator is not an option of method 'taylor' "
+        "(its options: --chart-threshold, --dps, --dt, --max-steps, --order, --precision, --tol)"
+    )
 
 
 def test_toml_output_file_is_relative_to_the_file(capsys, tmp_path, monkeypatch):
     sub = tmp_path / "cfg"
     sub.mkdir()
-    (sub / "r.toml").write_text('[body]\ninertia = [1, 2, 3]\n[initial]\nomega = [1, 0.1, 0.5]\n'
-                                '[time]\nt_end = 1.0\nsamples = 3\n[output]\nfile = "out.nc"\n')
+    (sub / "r.toml").write_text(
+        "[body]\ninertia = [1, 2, 3]\n[initial]\nomega = [1, 0.1, 0.5]\n"
+        '[time]\nt_end = 1.0\nsamples = 3\n[output]\nfile = "out.nc"\n'
+    )
     monkeypatch.chdir(tmp_path)
     code, out, err = run(capsys, "simulate", "cfg/r.toml", "--quiet")
     assert code == 0, err
@@ -77,8 +138,10 @@ def test_numbers_must_be_ascii_and_nesting_is_bounded(capsys, tmp_path):
 
 def test_a_closed_pipe_is_not_an_error(tmp_path):
     exe = str(Path(sys.executable).with_name("eulerpoisson"))
-    cmd = (f"{exe} simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 10 --samples 200000 --method exact --json "
-           f"| head -c 10")
+    cmd = (
+        f"{exe} simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 10 --samples 200000 --method exact --json "
+        f"| head -c 10"
+    )
     res = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True, timeout=120)
     assert "Broken pipe" not in res.stderr, res.stderr
     assert res.returncode == 0, res.stderr
@@ -98,11 +161,22 @@ def test_overflow_and_masked_or_boolean_input_are_errors():
 
 
 def test_absurd_and_too_large_sample_counts_are_named_before_allocating(capsys):
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
-                         "--samples", "99999999999999999999999")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0,0",
+        "--t-end",
+        "1",
+        "--samples",
+        "99999999999999999999999",
+    )
     assert code == 2 and "--samples = 99999999999999999999999 is more than 1e+13 output times" in err
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1",
-                         "--samples", "1000000000000")
+    code, out, err = run(
+        capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "1", "--samples", "1000000000000"
+    )
     assert code == 2 and "GiB in memory" in err and "--out run.zarr" in err
 
 
@@ -135,8 +209,9 @@ def test_a_run_written_nowhere_keeps_its_ends_and_the_same_drift():
     t = np.linspace(0.0, 50.0, 12001)
     model = ep.Model([1, 2, 3])
     full = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
-    ends, drift = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False,
-                                            keep=False)
+    ends, drift = commands._solve_in_chunks(
+        model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False, keep=False
+    )
     assert ends.t.tolist() == [0.0, 50.0]
     np.testing.assert_array_equal(ends.quaternion[-1], full.quaternion[-1])
     assert drift == full.drift()
@@ -164,8 +239,24 @@ def test_the_help_examples_of_info_and_animate_run(capsys, tmp_path, monkeypatch
 
     monkeypatch.chdir(tmp_path)
     ep.solve([1, 2, 3], np.linspace(0, 10, 101), omega0=[1, 0.1, 0.5]).to_netcdf(tmp_path / "run.nc")
-    assert run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10", "--samples",
-               "20000", "--out", "long.zarr", "--quiet")[0] == 0
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0.1,0.5",
+            "--t-end",
+            "10",
+            "--samples",
+            "20000",
+            "--out",
+            "long.zarr",
+            "--quiet",
+        )[0]
+        == 0
+    )
     for command in ("info", "animate"):
         code, out, _ = run(capsys, command, "--help")
         assert code == 0

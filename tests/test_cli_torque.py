@@ -46,7 +46,7 @@ def one_error(capsys, argv, match):
     assert len(lines) == 1, err
     assert "Traceback" not in err
     assert lines[0].startswith("eulerpoisson: error: "), lines[0]  # every error line starts the same way
-    msg = lines[0][len("eulerpoisson: error: "):]
+    msg = lines[0][len("eulerpoisson: error: ") :]
     assert re.search(match, lines[0]) or re.search(match, msg), lines[0]
     assert out == ""
     return lines[0]
@@ -61,11 +61,23 @@ def close_state(d, tr, atol=1e-12):
 # flags
 # ---------------------------------------------------------------------------
 def test_heavy_top_flags_json(capsys):
-    d = ok_json(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--mass", "2", "--gravity", "0,0,-9.8",
-                "--t-end", "3", "--samples", "301")
+    d = ok_json(
+        capsys,
+        "simulate",
+        *TOP,
+        "--com",
+        "0,0,0.25",
+        "--mass",
+        "2",
+        "--gravity",
+        "0,0,-9.8",
+        "--t-end",
+        "3",
+        "--samples",
+        "301",
+    )
     assert d["method"] == "taylor"  # the default under a torque
-    assert d["torque"] == [{"kind": "gravity", "mass": 2.0, "center_of_mass": [0.0, 0.0, 0.25],
-                            "g": [0.0, 0.0, -9.8]}]
+    assert d["torque"] == [{"kind": "gravity", "mass": 2.0, "center_of_mass": [0.0, 0.0, 0.25], "g": [0.0, 0.0, -9.8]}]
     top = ep.torques.Gravity(2.0, [0, 0, 0.25], g=[0, 0, -9.8])
     ref = ep.solve(TOP_BODY, np.linspace(0, 3, 301), omega0=[0, 0, 10], attitude0=Q60, torque=top, method="taylor")
     close_state(d, ref)
@@ -81,21 +93,37 @@ def test_heavy_top_flags_json(capsys):
 
 def test_com_alone_gives_unit_mass_and_standard_gravity(capsys):
     d = ok_json(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--t-end", "1", "--samples", "11")
-    assert d["torque"] == [{"kind": "gravity", "mass": 1.0, "center_of_mass": [0.0, 0.0, 0.25],
-                            "g": [0.0, 0.0, -9.81]}]
-    d2 = ok_json(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--mass", "1", "--gravity", "0,0,-9.81",
-                 "--t-end", "1", "--samples", "11")
+    assert d["torque"] == [{"kind": "gravity", "mass": 1.0, "center_of_mass": [0.0, 0.0, 0.25], "g": [0.0, 0.0, -9.81]}]
+    d2 = ok_json(
+        capsys,
+        "simulate",
+        *TOP,
+        "--com",
+        "0,0,0.25",
+        "--mass",
+        "1",
+        "--gravity",
+        "0,0,-9.81",
+        "--t-end",
+        "1",
+        "--samples",
+        "11",
+    )
     assert d2 == d
 
 
-@pytest.mark.parametrize("flag, value, tq", [
-    ("--gravity-gradient", "0.3", ep.torques.GravityGradient(0.3)),
-    ("--body-torque", "0.1,-0.2,0.3", ep.torques.BodyTorque([0.1, -0.2, 0.3])),
-    ("--space-torque", "-0.1,0.2,0.05", ep.torques.SpaceTorque([-0.1, 0.2, 0.05])),
-])
+@pytest.mark.parametrize(
+    "flag, value, tq",
+    [
+        ("--gravity-gradient", "0.3", ep.torques.GravityGradient(0.3)),
+        ("--body-torque", "0.1,-0.2,0.3", ep.torques.BodyTorque([0.1, -0.2, 0.3])),
+        ("--space-torque", "-0.1,0.2,0.05", ep.torques.SpaceTorque([-0.1, 0.2, 0.05])),
+    ],
+)
 def test_each_torque_flag(capsys, flag, value, tq):
-    d = ok_json(capsys, "simulate", "--inertia", "1,2,3", "--omega", "0.3,1,0.2", flag, value, "--t-end", "4",
-                "--samples", "41")
+    d = ok_json(
+        capsys, "simulate", "--inertia", "1,2,3", "--omega", "0.3,1,0.2", flag, value, "--t-end", "4", "--samples", "41"
+    )
     assert d["method"] == "taylor"
     assert d["torque"] == [tq.to_dict()]
     ref = ep.solve([1, 2, 3], np.linspace(0, 4, 41), omega0=[0.3, 1, 0.2], torque=tq, method="taylor")
@@ -105,8 +133,23 @@ def test_each_torque_flag(capsys, flag, value, tq):
 
 
 def test_torques_add_up_and_other_methods(capsys):
-    argv = ["simulate", "--inertia", "1,2,3", "--omega", "0.3,1,0.2", "--com", "0.1,0,0.2", "--body-torque",
-            "0,0,0.1", "--space-torque", "0.1,0,0", "--t-end", "2", "--samples", "21"]
+    argv = [
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "0.3,1,0.2",
+        "--com",
+        "0.1,0,0.2",
+        "--body-torque",
+        "0,0,0.1",
+        "--space-torque",
+        "0.1,0,0",
+        "--t-end",
+        "2",
+        "--samples",
+        "21",
+    ]
     d = ok_json(capsys, *argv)
     assert [r["kind"] for r in d["torque"]] == ["gravity", "body_torque", "space_torque"]
     d_rk = ok_json(capsys, *argv, "--method", "rk", "--tol", "1e-12")
@@ -130,8 +173,23 @@ def test_text_output_names_the_torque(capsys):
 
 
 def test_method_exact_with_an_unsupported_torque(capsys):
-    line = one_error(capsys, ["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--gravity-gradient", "0.1",
-                              "--t-end", "1", "--method", "exact"], r"method 'exact' cannot run")
+    line = one_error(
+        capsys,
+        [
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0,0",
+            "--gravity-gradient",
+            "0.1",
+            "--t-end",
+            "1",
+            "--method",
+            "exact",
+        ],
+        r"method 'exact' cannot run",
+    )
     assert line.startswith("eulerpoisson: error:") and "taylor" in line and "rk" in line
 
 
@@ -153,8 +211,25 @@ def test_method_exact_for_a_lagrange_top_either_way(capsys):
 
 def test_method_exact_with_a_torque_writes_nothing(capsys, tmp_path):
     store = tmp_path / "r.zarr"
-    one_error(capsys, ["simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--body-torque", "0,0,1",
-                       "--t-end", "1", "--method", "exact", "--out", str(store)], r"cannot run")
+    one_error(
+        capsys,
+        [
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0,0",
+            "--body-torque",
+            "0,0,1",
+            "--t-end",
+            "1",
+            "--method",
+            "exact",
+            "--out",
+            str(store),
+        ],
+        r"cannot run",
+    )
     assert not store.exists() and os.listdir(tmp_path) == []
 
 
@@ -187,8 +262,22 @@ def test_bad_torque_flags_are_one_line(capsys, extra, match):
 
 def test_negative_values_after_torque_flags(capsys):
     """``--body-torque -1,0,0`` is read as a value, as for --omega."""
-    d = ok_json(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--body-torque", "-1,0,0",
-                "--space-torque", "-0.5,0,0", "--t-end", "1", "--samples", "3")
+    d = ok_json(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0,0",
+        "--body-torque",
+        "-1,0,0",
+        "--space-torque",
+        "-0.5,0,0",
+        "--t-end",
+        "1",
+        "--samples",
+        "3",
+    )
     assert d["torque"][0]["tau"] == [-1.0, 0.0, 0.0] and d["torque"][1]["tau"] == [-0.5, 0.0, 0.0]
 
 
@@ -208,8 +297,14 @@ def test_toml_torque_section(capsys, tmp_path):
     d = ok_json(capsys, "simulate", str(cfg))
     assert d["method"] == "taylor"
     assert d["torque"] == [{"kind": "gravity", "mass": 2.0, "center_of_mass": [0.0, 0.0, 0.1], "g": [0.0, 0.0, -9.8]}]
-    ref = ep.solve(TOP_BODY, np.linspace(0, 2, 201), omega0=[0, 0, 10], attitude0=Q60,
-                   torque=ep.torques.Gravity(2.0, [0, 0, 0.1], g=[0, 0, -9.8]), method="taylor")
+    ref = ep.solve(
+        TOP_BODY,
+        np.linspace(0, 2, 201),
+        omega0=[0, 0, 10],
+        attitude0=Q60,
+        torque=ep.torques.Gravity(2.0, [0, 0, 0.1], g=[0, 0, -9.8]),
+        method="taylor",
+    )
     close_state(d, ref)
     # flags override the file, key by key
     d2 = ok_json(capsys, "simulate", str(cfg), "--mass", "3", "--com", "0,0,0.2")
@@ -234,17 +329,26 @@ def test_toml_all_torque_keys(capsys, tmp_path):
     ]
 
 
-@pytest.mark.parametrize("text, match", [
-    ("[torque]\nmass = 'heavy'\ncenter_of_mass = [0, 0, 1]\n", r"top\.toml: \[torque\] mass must be a number, got \"heavy\""),
-    ("[torque]\ncenter_of_mass = 0.1\n", r"\[torque\] center_of_mass must be a list of numbers"),
-    ("[torque]\ngravity_gradient = [0.1]\n", r"\[torque\] gravity_gradient must be a number"),
-    ("[torque]\nbody_torque = [1, 'a', 3]\n", r"\[torque\] body_torque must be a list of numbers"),
-    ("[torque]\ncom = [0, 0, 1]\n", r"unknown key\(s\) com in \[torque\]; known: body_torque, center_of_mass, gravity"),
-    ("[torque]\nmass = 2.0\n", r"top\.toml: \[torque\] mass needs the centre of mass of the heavy top"),
-    ("[torque]\ncenter_of_mass = [0, 0]\n", r"top\.toml: \[torque\] center_of_mass: expected 3 numbers"),
-    ("[torque]\ncenter_of_mass = [0, 0, 1]\nmass = -2\n", r"\[torque\] mass must be a finite number > 0"),
-    ("[torque]\ngravity_gradient = -1\n", r"\[torque\] gravity_gradient must be a finite number >= 0"),
-])
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        (
+            "[torque]\nmass = 'heavy'\ncenter_of_mass = [0, 0, 1]\n",
+            r"top\.toml: \[torque\] mass must be a number, got \"heavy\"",
+        ),
+        ("[torque]\ncenter_of_mass = 0.1\n", r"\[torque\] center_of_mass must be a list of numbers"),
+        ("[torque]\ngravity_gradient = [0.1]\n", r"\[torque\] gravity_gradient must be a number"),
+        ("[torque]\nbody_torque = [1, 'a', 3]\n", r"\[torque\] body_torque must be a list of numbers"),
+        (
+            "[torque]\ncom = [0, 0, 1]\n",
+            r"unknown key\(s\) com in \[torque\]; known: body_torque, center_of_mass, gravity",
+        ),
+        ("[torque]\nmass = 2.0\n", r"top\.toml: \[torque\] mass needs the centre of mass of the heavy top"),
+        ("[torque]\ncenter_of_mass = [0, 0]\n", r"top\.toml: \[torque\] center_of_mass: expected 3 numbers"),
+        ("[torque]\ncenter_of_mass = [0, 0, 1]\nmass = -2\n", r"\[torque\] mass must be a finite number > 0"),
+        ("[torque]\ngravity_gradient = -1\n", r"\[torque\] gravity_gradient must be a finite number >= 0"),
+    ],
+)
 def test_bad_torque_section_is_one_line(capsys, tmp_path, text, match):
     cfg = tmp_path / "top.toml"
     cfg.write_text("[body]\ninertia = [1, 2, 3]\n[initial]\nomega = [1, 0, 0]\n[time]\nt_end = 1\n" + text)
@@ -262,8 +366,23 @@ def test_torque_that_is_not_a_table(capsys, tmp_path):
 # ---------------------------------------------------------------------------
 def test_netcdf_round_trip_and_info(capsys, tmp_path):
     path = tmp_path / "top.nc"
-    code, out, err = run(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--mass", "1.5", "--body-torque", "0,0,0.01",
-                         "--t-end", "2", "--samples", "101", "--out", str(path))
+    code, out, err = run(
+        capsys,
+        "simulate",
+        *TOP,
+        "--com",
+        "0,0,0.25",
+        "--mass",
+        "1.5",
+        "--body-torque",
+        "0,0,0.01",
+        "--t-end",
+        "2",
+        "--samples",
+        "101",
+        "--out",
+        str(path),
+    )
     assert code == 0, err
     tr = ep.Trajectory.from_netcdf(path)
     assert [t.to_dict() for t in tr.model.torques] == [
@@ -277,8 +396,10 @@ def test_netcdf_round_trip_and_info(capsys, tmp_path):
         np.testing.assert_allclose(ds["energy"].values, tr.energy, rtol=1e-14)  # with the potential
     code, out, err = run(capsys, "info", str(path))
     assert code == 0, err
-    assert "torque      Gravity(mass=1.5, center_of_mass=[0.0, 0.0, 0.25], g=[0.0, 0.0, -9.81]) + " \
-           "BodyTorque(tau=[0.0, 0.0, 0.01])" in out
+    assert (
+        "torque      Gravity(mass=1.5, center_of_mass=[0.0, 0.0, 0.25], g=[0.0, 0.0, -9.81]) + "
+        "BodyTorque(tau=[0.0, 0.0, 0.01])" in out
+    )
     assert "(kinetic + potential)" in out and "energy" in out
     # a free-body file says so
     free = tmp_path / "free.nc"
@@ -291,14 +412,22 @@ def test_zarr_streaming_records_the_torque(capsys, tmp_path):
     xr = pytest.importorskip("xarray")
     pytest.importorskip("zarr")
     store = tmp_path / "top.zarr"
-    d = ok_json(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--t-end", "2", "--samples", "201",
-                "--out", str(store))
+    d = ok_json(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--t-end", "2", "--samples", "201", "--out", str(store))
     ds = xr.open_zarr(store)
-    assert json.loads(ds.attrs["torque"]) == d["torque"] == [
-        {"kind": "gravity", "mass": 1.0, "center_of_mass": [0.0, 0.0, 0.25], "g": [0.0, 0.0, -9.81]}]
+    assert (
+        json.loads(ds.attrs["torque"])
+        == d["torque"]
+        == [{"kind": "gravity", "mass": 1.0, "center_of_mass": [0.0, 0.0, 0.25], "g": [0.0, 0.0, -9.81]}]
+    )
     assert ds.attrs["method"] == "taylor" and "under torque" in ds.attrs["title"]
-    ref = ep.solve(TOP_BODY, np.linspace(0, 2, 201), omega0=[0, 0, 10], attitude0=Q60,
-                   torque=ep.torques.Gravity(1.0, [0, 0, 0.25]), method="taylor")
+    ref = ep.solve(
+        TOP_BODY,
+        np.linspace(0, 2, 201),
+        omega0=[0, 0, 10],
+        attitude0=Q60,
+        torque=ep.torques.Gravity(1.0, [0, 0, 0.25]),
+        method="taylor",
+    )
     np.testing.assert_allclose(ds["omega"].values, ref.omega, atol=1e-12)
     np.testing.assert_allclose(ds["energy"].values, ref.energy, rtol=1e-13)  # with the potential
 
@@ -310,11 +439,24 @@ def test_solve_to_file_in_chunks_under_time_dependent_torques(tmp_path, method, 
     pytest.importorskip("zarr")
     from eulerpoisson.io.stream import solve_to_file
 
-    torques = [ep.torques.GravityGradient(0.7), ep.torques.Gravity(1.0, [0.1, 0, 0.2], g=[0.3, 0.1, -9.81]),
-               ep.torques.SpaceTorque([0.1, 0.2, 0.3]), ep.torques.BodyTorque([0, 0.1, 0])]
+    torques = [
+        ep.torques.GravityGradient(0.7),
+        ep.torques.Gravity(1.0, [0.1, 0, 0.2], g=[0.3, 0.1, -9.81]),
+        ep.torques.SpaceTorque([0.1, 0.2, 0.3]),
+        ep.torques.BodyTorque([0, 0.1, 0]),
+    ]
     t = np.linspace(0, 6, 61)
-    path = solve_to_file([1, 2, 3], (0.0, 6.0, 61), tmp_path / "gg.zarr", omega0=[0.3, 1, 0.2], torque=torques,
-                         method=method, chunk=20, progress=False, **opts)
+    path = solve_to_file(
+        [1, 2, 3],
+        (0.0, 6.0, 61),
+        tmp_path / "gg.zarr",
+        omega0=[0.3, 1, 0.2],
+        torque=torques,
+        method=method,
+        chunk=20,
+        progress=False,
+        **opts,
+    )
     ref = ep.solve([1, 2, 3], t, omega0=[0.3, 1, 0.2], torque=torques, method=method, **opts)
     ds = xr.open_zarr(path)
     np.testing.assert_allclose(ds["omega"].values, ref.omega, atol=atol)
@@ -334,8 +476,17 @@ def test_solve_to_file_callable_torque_in_chunks_and_resume_fingerprint(tmp_path
 
     torques = [ep.torques.GravityGradient(0.5), kick]
     t = np.linspace(0, 4, 41)
-    path = solve_to_file([1, 2, 3], t, tmp_path / "k.zarr", omega0=[0.3, 1, 0.2], torque=torques, method="rk",
-                         tol=1e-12, chunk=15, progress=False)
+    path = solve_to_file(
+        [1, 2, 3],
+        t,
+        tmp_path / "k.zarr",
+        omega0=[0.3, 1, 0.2],
+        torque=torques,
+        method="rk",
+        tol=1e-12,
+        chunk=15,
+        progress=False,
+    )
     ref = ep.solve([1, 2, 3], t, omega0=[0.3, 1, 0.2], torque=torques, method="rk", tol=1e-12)
     ds = xr.open_zarr(path)
     np.testing.assert_allclose(ds["omega"].values, ref.omega, atol=1e-8)
@@ -352,15 +503,43 @@ def test_solve_to_file_callable_torque_in_chunks_and_resume_fingerprint(tmp_path
     dest = tmp_path / "r.zarr"
     top = ep.torques.Gravity(1.0, [0, 0, 0.2])
     with pytest.raises(KeyboardInterrupt):
-        solve_to_file([1, 1, 0.5], (0.0, 2.0, 40), dest, omega0=[0, 0, 10], attitude0=Q60, torque=top,
-                      method="taylor", chunk=10, progress=stop)
+        solve_to_file(
+            [1, 1, 0.5],
+            (0.0, 2.0, 40),
+            dest,
+            omega0=[0, 0, 10],
+            attitude0=Q60,
+            torque=top,
+            method="taylor",
+            chunk=10,
+            progress=stop,
+        )
     assert Path(partial_store(dest)).exists()
     with pytest.raises(InvalidInputError, match="different arguments"):
-        solve_to_file([1, 1, 0.5], (0.0, 2.0, 40), dest, omega0=[0, 0, 10], attitude0=Q60,
-                      torque=ep.torques.Gravity(2.0, [0, 0, 0.2]), method="taylor", chunk=10, progress=False,
-                      resume=True)
-    solve_to_file([1, 1, 0.5], (0.0, 2.0, 40), dest, omega0=[0, 0, 10], attitude0=Q60, torque=top,
-                  method="taylor", chunk=10, progress=False, resume=True)
+        solve_to_file(
+            [1, 1, 0.5],
+            (0.0, 2.0, 40),
+            dest,
+            omega0=[0, 0, 10],
+            attitude0=Q60,
+            torque=ep.torques.Gravity(2.0, [0, 0, 0.2]),
+            method="taylor",
+            chunk=10,
+            progress=False,
+            resume=True,
+        )
+    solve_to_file(
+        [1, 1, 0.5],
+        (0.0, 2.0, 40),
+        dest,
+        omega0=[0, 0, 10],
+        attitude0=Q60,
+        torque=top,
+        method="taylor",
+        chunk=10,
+        progress=False,
+        resume=True,
+    )
     ref = ep.solve([1, 1, 0.5], np.linspace(0, 2, 40), omega0=[0, 0, 10], attitude0=Q60, torque=top, method="taylor")
     np.testing.assert_allclose(xr.open_zarr(dest)["omega"].values, ref.omega, atol=1e-12)
 
@@ -370,21 +549,49 @@ def test_solve_to_file_refuses_an_unsupported_model_before_writing(tmp_path):
     from eulerpoisson.io.stream import solve_to_file
 
     with pytest.raises(ep.UnsupportedModelError, match="methods that can"):
-        solve_to_file([1, 2, 3], (0.0, 1.0, 5), tmp_path / "x.zarr", omega0=[1, 0, 0],
-                      torque=ep.torques.GravityGradient(0.1), method="exact")
+        solve_to_file(
+            [1, 2, 3],
+            (0.0, 1.0, 5),
+            tmp_path / "x.zarr",
+            omega0=[1, 0, 0],
+            torque=ep.torques.GravityGradient(0.1),
+            method="exact",
+        )
     assert os.listdir(tmp_path) == []
 
 
 def test_long_simulate_in_chunks_under_a_gravity_gradient(capsys, tmp_path):
     n = cli.CHUNKED_SAMPLES + 1
     path = tmp_path / "long.nc"
-    code, out, err = run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "0.3,1,0.2", "--gravity-gradient",
-                         "0.5", "--com", "0,0,0.1", "--t-end", "20", "--samples", str(n), "--out", str(path), "--json")
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "0.3,1,0.2",
+        "--gravity-gradient",
+        "0.5",
+        "--com",
+        "0,0,0.1",
+        "--t-end",
+        "20",
+        "--samples",
+        str(n),
+        "--out",
+        str(path),
+        "--json",
+    )
     assert code == 0, err
     tr = ep.Trajectory.from_netcdf(path)
     assert tr.stats["chunks"] > 1 and len(tr.model.torques) == 2
-    ref = ep.solve([1, 2, 3], tr.t, omega0=[0.3, 1, 0.2], method="taylor",
-                   torque=[ep.torques.Gravity(1.0, [0, 0, 0.1]), ep.torques.GravityGradient(0.5)])
+    ref = ep.solve(
+        [1, 2, 3],
+        tr.t,
+        omega0=[0.3, 1, 0.2],
+        method="taylor",
+        torque=[ep.torques.Gravity(1.0, [0, 0, 0.1]), ep.torques.GravityGradient(0.5)],
+    )
     np.testing.assert_allclose(tr.omega, ref.omega, atol=1e-10)
     assert np.max(np.abs(np.abs(np.sum(tr.quaternion * ref.quaternion, -1)) - 1)) < 1e-12
 
@@ -395,8 +602,10 @@ def test_long_simulate_in_chunks_under_a_gravity_gradient(capsys, tmp_path):
 def test_plot_apex_from_the_command_line(capsys, tmp_path):
     pytest.importorskip("matplotlib")
     path = tmp_path / "top.nc"
-    assert run(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--t-end", "3", "--samples", "301",
-               "--out", str(path))[0] == 0
+    assert (
+        run(capsys, "simulate", *TOP, "--com", "0,0,0.25", "--t-end", "3", "--samples", "301", "--out", str(path))[0]
+        == 0
+    )
     png = tmp_path / "apex.png"
     code, out, err = run(capsys, "plot", str(path), "--kind", "apex", "--out", str(png))
     assert code == 0, err
@@ -440,8 +649,9 @@ def test_plot_apex_decimates_long_runs():
     from eulerpoisson.viz import plots
 
     n = 100_001
-    tr = ep.Trajectory(np.linspace(0, 10, n), np.tile([1.0, 0, 0, 0], (n, 1)), np.zeros((n, 3)),
-                       ep.RigidBody([1, 1, 0.5]))
+    tr = ep.Trajectory(
+        np.linspace(0, 10, n), np.tile([1.0, 0, 0, 0], (n, 1)), np.zeros((n, 3)), ep.RigidBody([1, 1, 0.5])
+    )
     fig = plots.plot_apex(tr)
     from matplotlib.collections import LineCollection
 
@@ -499,8 +709,24 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
     assert any("--com" in c for c in sim) and any("--gravity-gradient" in c for c in sim)
     assert any("apex" in c for c in sim + plot)
     # the store the plot examples read (the README's 1e8-sample long.zarr, smaller)
-    assert run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "100",
-               "--samples", "20000", "--out", "long.zarr", "--quiet")[0] == 0
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0.1,0.5",
+            "--t-end",
+            "100",
+            "--samples",
+            "20000",
+            "--out",
+            "long.zarr",
+            "--quiet",
+        )[0]
+        == 0
+    )
     ran = 0
     for argv in sim + plot:
         code, out, err = run(capsys, *argv)

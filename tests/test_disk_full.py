@@ -15,8 +15,7 @@ EXE = str(Path(sys.executable).with_name("eulerpoisson"))
 def small_disk(tmp_path):
     mnt = tmp_path / "small"
     mnt.mkdir()
-    res = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mnt)], capture_output=True,
-                         text=True)
+    res = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(mnt)], capture_output=True, text=True)
     if res.returncode != 0:
         pytest.skip(f"cannot mount a small tmpfs here (needs root): {res.stderr.strip()}")
     try:
@@ -27,8 +26,25 @@ def small_disk(tmp_path):
 
 def test_disk_full_during_netcdf_write(small_disk):
     out = small_disk / "x.nc"
-    res = subprocess.run([EXE, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10",
-                          "--samples", "20000", "--out", str(out)], capture_output=True, text=True, timeout=300)
+    res = subprocess.run(
+        [
+            EXE,
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0.1,0.5",
+            "--t-end",
+            "10",
+            "--samples",
+            "20000",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert res.returncode == 2, (res.returncode, res.stderr)
     assert res.stderr.strip() == f"eulerpoisson: error: cannot write {out}: No space left on device"
     assert list(small_disk.iterdir()) == []

@@ -60,14 +60,21 @@ def examples_section(doc: str) -> str | None:
     for i, m in enumerate(heads):
         if m.group(1).strip() == "Examples":
             end = heads[i + 1].start() if i + 1 < len(heads) else len(doc)
-            return doc[m.end():end]
+            return doc[m.end() : end]
     return None
 
 
 def test_the_public_api_is_found():
-    for name in ("eulerpoisson.RigidBody", "eulerpoisson.solve", "eulerpoisson.Trajectory",
-                 "eulerpoisson.attitude.gibbs_compose", "eulerpoisson.solvers.TaylorOptions",
-                 "eulerpoisson.torques.Gravity", "eulerpoisson.oracle.validate", "eulerpoisson.sweep.run_sweep"):
+    for name in (
+        "eulerpoisson.RigidBody",
+        "eulerpoisson.solve",
+        "eulerpoisson.Trajectory",
+        "eulerpoisson.attitude.gibbs_compose",
+        "eulerpoisson.solvers.TaylorOptions",
+        "eulerpoisson.torques.Gravity",
+        "eulerpoisson.oracle.validate",
+        "eulerpoisson.sweep.run_sweep",
+    ):
         assert name in PUBLIC or any(obj is _resolve(name) for obj in PUBLIC.values()), name
     assert len(PUBLIC) > 80
 
@@ -78,7 +85,9 @@ def _resolve(dotted: str):
 
 
 def test_examples_section_parser():
-    doc = "Summary.\n\nParameters\n----------\nx : int\n\nExamples\n--------\n>>> 1 + 1\n2\n\nReferences\n----------\nA."
+    doc = (
+        "Summary.\n\nParameters\n----------\nx : int\n\nExamples\n--------\n>>> 1 + 1\n2\n\nReferences\n----------\nA."
+    )
     assert examples_section(doc).strip() == ">>> 1 + 1\n2"
     assert examples_section("Summary.\n\nNotes\n-----\n>>> 1\n1") is None
 
@@ -92,6 +101,11 @@ def test_public_callable_has_examples_with_output(name):
     assert section is not None, f"{name}: no numpydoc 'Examples' section (a heading 'Examples' underlined by dashes)"
     examples = doctest.DocTestParser().get_examples(section, name)
     assert examples, f"{name}: the Examples section has no '>>>' example"
-    shown = [ex for ex in examples if ex.want.strip() and "+SKIP" not in ex.source
-             and not any(flag == doctest.SKIP and on for flag, on in ex.options.items())]
+    shown = [
+        ex
+        for ex in examples
+        if ex.want.strip()
+        and "+SKIP" not in ex.source
+        and not any(flag == doctest.SKIP and on for flag, on in ex.options.items())
+    ]
     assert shown, f"{name}: no example shows its output (a '>>>' line followed by what it prints, not skipped)"

@@ -145,9 +145,15 @@ def _libm_numpy():
     x = np.random.default_rng(1).uniform(-6, 6, 4000)
     pos = np.abs(x)
     pairs = [
-        (np.sin, math.sin, x), (np.cos, math.cos, x), (np.tanh, math.tanh, x), (np.exp, math.exp, x),
-        (np.sinh, math.sinh, x), (np.cosh, math.cosh, x), (np.arctan, math.atan, x),
-        (np.log1p, math.log1p, pos), (np.arcsinh, math.asinh, x),
+        (np.sin, math.sin, x),
+        (np.cos, math.cos, x),
+        (np.tanh, math.tanh, x),
+        (np.exp, math.exp, x),
+        (np.sinh, math.sinh, x),
+        (np.cosh, math.cosh, x),
+        (np.arctan, math.atan, x),
+        (np.log1p, math.log1p, pos),
+        (np.arcsinh, math.asinh, x),
     ]
     for nf, mf, v in pairs:
         if not np.array_equal(nf(v), np.array([mf(e) for e in v])):
@@ -293,9 +299,17 @@ def test_numpy_fallback_in_subprocess_matches(tmp_path):
     script = tmp_path / "run.py"
     script.write_text(_SCRIPT)
     proc = subprocess.run(
-        [sys.executable, str(script), str(tmp_path / "in.npz"), str(tmp_path / "out.npz"),
-         os.path.dirname(os.path.abspath(__file__))],
-        capture_output=True, text=True, timeout=300, env=_numpy_libm_env(),
+        [
+            sys.executable,
+            str(script),
+            str(tmp_path / "in.npz"),
+            str(tmp_path / "out.npz"),
+            os.path.dirname(os.path.abspath(__file__)),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=_numpy_libm_env(),
     )
     assert proc.returncode == 0, proc.stderr[-3000:]
     info = json.loads(proc.stdout.strip().splitlines()[-1])

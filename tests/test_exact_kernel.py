@@ -189,7 +189,9 @@ def landau_reference(inertia, M0, ts, dps=50):
             e[ax] = s
             r1 = mp.matrix([e[1] * Mh[2] - e[2] * Mh[1], e[2] * Mh[0] - e[0] * Mh[2], e[0] * Mh[1] - e[1] * Mh[0]])
             r1 = r1 / mp.norm(r1)
-            r2 = mp.matrix([Mh[1] * r1[2] - Mh[2] * r1[1], Mh[2] * r1[0] - Mh[0] * r1[2], Mh[0] * r1[1] - Mh[1] * r1[0]])
+            r2 = mp.matrix(
+                [Mh[1] * r1[2] - Mh[2] * r1[1], Mh[2] * r1[0] - Mh[0] * r1[2], Mh[0] * r1[1] - Mh[1] * r1[0]]
+            )
             return mp.matrix([[r1[i] for i in range(3)], [r2[i] for i in range(3)], [Mh[i] for i in range(3)]])
 
         B0 = frame([M1, M2, M3])
@@ -351,8 +353,17 @@ def test_tennis_racket_flip_period():
     def ev(t, y, I):
         return y[1]
 
-    sol = solve_ivp(rhs, [0, 4.2 * flip], np.concatenate([M0, [1, 0, 0, 0]]), method="DOP853",
-                    rtol=1e-12, atol=1e-14, events=ev, args=(inertia,), dense_output=True)
+    sol = solve_ivp(
+        rhs,
+        [0, 4.2 * flip],
+        np.concatenate([M0, [1, 0, 0, 0]]),
+        method="DOP853",
+        rtol=1e-12,
+        atol=1e-14,
+        events=ev,
+        args=(inertia,),
+        dense_output=True,
+    )
     tev = sol.t_events[0]
     assert len(tev) == 4
     np.testing.assert_allclose(np.diff(tev), flip, rtol=1e-8)
@@ -528,8 +539,9 @@ def test_near_equilibrium_and_equilibria():
         inertia, M0 = np.array(inertia), np.array(M0)
         assert exact_constants(inertia, M0).regime == EQUILIBRIUM
         M, q = exact_motion(inertia, M0, np.array([0.0, 5.0]))
-        sol = solve_ivp(rhs, [0, 5], np.concatenate([M0, [1, 0, 0, 0]]), method="DOP853",
-                        rtol=1e-13, atol=1e-14, args=(inertia,))
+        sol = solve_ivp(
+            rhs, [0, 5], np.concatenate([M0, [1, 0, 0, 0]]), method="DOP853", rtol=1e-13, atol=1e-14, args=(inertia,)
+        )
         np.testing.assert_allclose(M[-1], sol.y[:3, -1], atol=1e-12)
         np.testing.assert_allclose(q[-1], sol.y[3:, -1], atol=1e-12)
 

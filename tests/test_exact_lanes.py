@@ -72,12 +72,12 @@ def test_lanes_equal_scalar_kernel_monte_carlo(seed):
     assert len(inertia) % LN.LANES != 0
     t = _times(rng)
     for j in range(0, len(t), 5):
-        _assert_same(inertia, M0, t[j:j + 2])
+        _assert_same(inertia, M0, t[j : j + 2])
     # every body at its own switch time between the near and the far branch
     sw = _switch_times(inertia, M0)
     for k in range(sw.shape[1]):
         for i in range(0, len(inertia), 9):
-            _assert_same(inertia[i:i + 9], M0[i:i + 9], sw[i, k:k + 1])
+            _assert_same(inertia[i : i + 9], M0[i : i + 9], sw[i, k : k + 1])
     for n in (1, LN.LANES - 1, LN.LANES, LN.LANES + 1, 2 * LN.LANES + 3):
         _assert_same(inertia[:n], M0[:n], np.array([0.37, -2.5]))
 
@@ -93,7 +93,7 @@ def test_lanes_do_not_depend_on_grouping():
     np.testing.assert_array_equal(Mp, Mf[order])
     np.testing.assert_array_equal(qp, qf[order])
     for j in (0, 3, len(t) - 1):
-        Mj, qj = _run(K.motion_kernel, inertia, M0, t[j:j + 1])  # Monte-Carlo mode
+        Mj, qj = _run(K.motion_kernel, inertia, M0, t[j : j + 1])  # Monte-Carlo mode
         np.testing.assert_array_equal(Mj[:, 0], Mf[:, j])
         np.testing.assert_array_equal(qj[:, 0], qf[:, j])
 

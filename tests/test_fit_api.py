@@ -96,6 +96,7 @@ A_BODY = np.array([0.0, 0.6, 0.8])
 # ----------------------------------------------------------------------------
 # shared fits (module scope: computed once)
 
+
 @pytest.fixture(scope="module")
 def noisy():
     """Attitude and body rates with Gaussian noise, sigmas given: (result, data)."""
@@ -129,6 +130,7 @@ def axis_fit():
 # ----------------------------------------------------------------------------
 # 1. input errors
 
+
 def _unit_nonunit():
     q = Q11.copy()
     q[3] *= 1.01
@@ -152,10 +154,16 @@ DIR11 = _matrix(Q11) @ A_BODY
 INPUT_ERRORS = [
     # (id, kwargs of fit (t defaults to T11), match)
     ("unsorted t", dict(t=T11[::-1].copy(), attitude=Q11), r"t must be strictly increasing: unsorted"),
-    ("swapped t", dict(t=_with(T11, 4, 10.0), attitude=Q11),
-     r"t must be strictly increasing: unsorted times at rows 4"),
-    ("duplicate t", dict(t=np.r_[T11[:3], T11[2], T11[4:]], attitude=Q11),
-     r"t must be strictly increasing: duplicate times at rows 2 and 3"),
+    (
+        "swapped t",
+        dict(t=_with(T11, 4, 10.0), attitude=Q11),
+        r"t must be strictly increasing: unsorted times at rows 4",
+    ),
+    (
+        "duplicate t",
+        dict(t=np.r_[T11[:3], T11[2], T11[4:]], attitude=Q11),
+        r"t must be strictly increasing: duplicate times at rows 2 and 3",
+    ),
     ("2-D t", dict(t=T11[:, None], attitude=Q11), r"t must be a 1-D array"),
     ("single time", dict(t=[0.0], attitude=Q11[:1]), r"t must hold at least 2 observation times; got 1"),
     ("no time", dict(t=[], attitude=np.zeros((0, 4))), r"t must hold at least 2"),
@@ -165,13 +173,19 @@ INPUT_ERRORS = [
     ("non-unit quaternion", dict(attitude=_unit_nonunit()), r"attitude row 3 is not a unit quaternion"),
     ("attitude partly NaN", dict(attitude=_part_nan(Q11)), r"attitude row 3 is partly NaN"),
     ("omega partly NaN", dict(omega=_part_nan(W11, 5, 2)), r"omega row 5 is partly NaN"),
-    ("direction partly NaN", dict(axis=A_BODY, axis_direction=_part_nan(DIR11, 2, 0)),
-     r"axis_direction row 2 is partly NaN"),
+    (
+        "direction partly NaN",
+        dict(axis=A_BODY, axis_direction=_part_nan(DIR11, 2, 0)),
+        r"axis_direction row 2 is partly NaN",
+    ),
     ("attitude inf", dict(attitude=_with(Q11, (3, 1), np.inf)), r"attitude contains infinite values"),
     ("omega -inf", dict(omega=_with(W11, (0, 0), -np.inf)), r"omega contains infinite values"),
     ("omega shape", dict(omega=W11[:, :2]), r"omega must have shape \(11, 3\)"),
-    ("omega_frame inertial", dict(omega=W11, omega_frame="inertial"),
-     r"omega_frame must be 'body' or 'space'.*inertial"),
+    (
+        "omega_frame inertial",
+        dict(omega=W11, omega_frame="inertial"),
+        r"omega_frame must be 'body' or 'space'.*inertial",
+    ),
     ("axis_direction without axis", dict(attitude=Q11, axis_direction=DIR11), r"axis_direction is given without axis"),
     ("axis without axis_direction", dict(attitude=Q11, axis=A_BODY), r"axis is given without axis_direction"),
     ("zero axis", dict(axis=[0.0, 0.0, 0.0], axis_direction=DIR11), r"axis must be a non-zero body vector"),
@@ -179,51 +193,99 @@ INPUT_ERRORS = [
     ("attitude_sigma 0", dict(attitude=Q11, attitude_sigma=0.0), r"attitude_sigma must be positive and finite"),
     ("attitude_sigma < 0", dict(attitude=Q11, attitude_sigma=-1e-3), r"attitude_sigma must be positive"),
     ("attitude_sigma NaN", dict(attitude=Q11, attitude_sigma=np.nan), r"attitude_sigma must be positive and finite"),
-    ("attitude_sigma NaN in a row", dict(attitude=Q11, attitude_sigma=_with(np.ones(11), 4, np.nan)),
-     r"attitude_sigma must be positive and finite where there is an observation; row 4"),
+    (
+        "attitude_sigma NaN in a row",
+        dict(attitude=Q11, attitude_sigma=_with(np.ones(11), 4, np.nan)),
+        r"attitude_sigma must be positive and finite where there is an observation; row 4",
+    ),
     ("omega_sigma 0 in a component", dict(omega=W11, omega_sigma=[1e-3, 0.0, 1e-3]), r"omega_sigma must be positive"),
     ("omega_sigma inf", dict(omega=W11, omega_sigma=np.inf), r"omega_sigma must be positive and finite"),
     ("axis_sigma < 0", dict(axis=A_BODY, axis_direction=DIR11, axis_sigma=-1.0), r"axis_sigma must be positive"),
-    ("attitude_sigma shape (10,)", dict(attitude=Q11, attitude_sigma=np.ones(10)),
-     r"attitude_sigma must be a scalar or shape \(11,\); got shape \(10,\)"),
+    (
+        "attitude_sigma shape (10,)",
+        dict(attitude=Q11, attitude_sigma=np.ones(10)),
+        r"attitude_sigma must be a scalar or shape \(11,\); got shape \(10,\)",
+    ),
     ("attitude_sigma shape (3,)", dict(attitude=Q11, attitude_sigma=np.ones(3)), r"attitude_sigma must be a scalar"),
-    ("omega_sigma shape (11, 2)", dict(omega=W11, omega_sigma=np.ones((11, 2))),
-     r"omega_sigma must be a scalar.*\(11, 2\)"),
-    ("axis_sigma shape (11, 3)", dict(axis=A_BODY, axis_direction=DIR11, axis_sigma=np.ones((11, 3))),
-     r"axis_sigma must be a scalar or shape \(11,\)"),
-    ("attitude_sigma without attitude", dict(omega=W11, attitude_sigma=1e-3),
-     r"attitude_sigma is given without attitude"),
+    (
+        "omega_sigma shape (11, 2)",
+        dict(omega=W11, omega_sigma=np.ones((11, 2))),
+        r"omega_sigma must be a scalar.*\(11, 2\)",
+    ),
+    (
+        "axis_sigma shape (11, 3)",
+        dict(axis=A_BODY, axis_direction=DIR11, axis_sigma=np.ones((11, 3))),
+        r"axis_sigma must be a scalar or shape \(11,\)",
+    ),
+    (
+        "attitude_sigma without attitude",
+        dict(omega=W11, attitude_sigma=1e-3),
+        r"attitude_sigma is given without attitude",
+    ),
     ("omega_sigma without omega", dict(attitude=Q11, omega_sigma=1e-3), r"omega_sigma is given without omega"),
-    ("axis_sigma without directions", dict(attitude=Q11, axis_sigma=1e-3),
-     r"axis_sigma is given without axis_direction"),
-    ("principal_axes free", dict(attitude=Q11, principal_axes="free"),
-     r"principal_axes must be 'given' or 'fit'.*free"),
-    ("2 attitudes, inertia free", dict(t=T11[:2], attitude=Q11[:2]),
-     r"too few observations: 6 residuals for 8 unknowns \(attitude0_x.*I_yy\)"),
-    ("2 attitudes among NaN rows", dict(attitude=np.where(np.arange(11)[:, None] < 2, Q11, np.nan)),
-     r"too few observations: 6 residuals for 8 unknowns"),
-    ("2 attitudes, full tensor", dict(t=T11[:2], attitude=Q11[:2], principal_axes="fit"),
-     r"too few observations: 6 residuals for 11 unknowns"),
-    ("3 attitudes, full tensor", dict(t=T11[:3], attitude=Q11[:3], principal_axes="fit"),
-     r"too few observations: 9 residuals for 11 unknowns"),
-    ("one rate, inertia free", dict(t=T11[:2], omega=np.r_[W11[:1], np.full((1, 3), np.nan)]),
-     r"too few observations: 3 residuals for 5 unknowns"),
+    (
+        "axis_sigma without directions",
+        dict(attitude=Q11, axis_sigma=1e-3),
+        r"axis_sigma is given without axis_direction",
+    ),
+    (
+        "principal_axes free",
+        dict(attitude=Q11, principal_axes="free"),
+        r"principal_axes must be 'given' or 'fit'.*free",
+    ),
+    (
+        "2 attitudes, inertia free",
+        dict(t=T11[:2], attitude=Q11[:2]),
+        r"too few observations: 6 residuals for 8 unknowns \(attitude0_x.*I_yy\)",
+    ),
+    (
+        "2 attitudes among NaN rows",
+        dict(attitude=np.where(np.arange(11)[:, None] < 2, Q11, np.nan)),
+        r"too few observations: 6 residuals for 8 unknowns",
+    ),
+    (
+        "2 attitudes, full tensor",
+        dict(t=T11[:2], attitude=Q11[:2], principal_axes="fit"),
+        r"too few observations: 6 residuals for 11 unknowns",
+    ),
+    (
+        "3 attitudes, full tensor",
+        dict(t=T11[:3], attitude=Q11[:3], principal_axes="fit"),
+        r"too few observations: 9 residuals for 11 unknowns",
+    ),
+    (
+        "one rate, inertia free",
+        dict(t=T11[:2], omega=np.r_[W11[:1], np.full((1, 3), np.nan)]),
+        r"too few observations: 3 residuals for 5 unknowns",
+    ),
     ("nothing observed", dict(), r"no observations"),
     ("all rows missing", dict(attitude=np.full((11, 4), np.nan)), r"no observations"),
-    ("initial unknown key", dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": W0, "omega": W0}),
-     r"initial has unknown keys \['omega'\]"),
+    (
+        "initial unknown key",
+        dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": W0, "omega": W0}),
+        r"initial has unknown keys \['omega'\]",
+    ),
     ("initial without omega0", dict(attitude=Q11, initial={"inertia": MOMENTS}), r"initial needs 'omega0'"),
     ("initial without inertia", dict(attitude=Q11, initial={"omega0": W0}), r"initial needs 'inertia'"),
-    ("initial unphysical inertia", dict(attitude=Q11, initial={"inertia": [1.0, 1.0, 3.0], "omega0": W0}),
-     r"initial inertia must be a physical"),
+    (
+        "initial unphysical inertia",
+        dict(attitude=Q11, initial={"inertia": [1.0, 1.0, 3.0], "omega0": W0}),
+        r"initial inertia must be a physical",
+    ),
     ("NaN in t", dict(t=_with(T11, 0, np.nan), attitude=Q11), r"^t contains NaN or infinite"),
     ("inf in t", dict(t=_with(T11, 10, np.inf), attitude=Q11), r"^t contains NaN or infinite"),
     ("NaN axis", dict(axis=[0.0, np.nan, 1.0], axis_direction=DIR11), r"^axis contains NaN"),
     ("axis of 2 components", dict(axis=[0.0, 1.0], axis_direction=DIR11), r"^axis must have shape"),
-    ("NaN initial omega0", dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": [0.0, np.nan, 1.0]}),
-     r"initial omega0 must be 3 finite numbers"),
-    ("zero initial attitude0", dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": W0, "attitude0": [0.0] * 4}),
-     r"initial attitude0 contains a zero quaternion"),
+    (
+        "NaN initial omega0",
+        dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": [0.0, np.nan, 1.0]}),
+        r"initial omega0 must be 3 finite numbers",
+    ),
+    (
+        "zero initial attitude0",
+        dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": W0, "attitude0": [0.0] * 4}),
+        r"initial attitude0 contains a zero quaternion",
+    ),
     ("max_iter < 0", dict(attitude=Q11, max_iter=-1), r"max_iter must be a non-negative integer"),
     ("batch of fixed inertias", dict(attitude=Q11, inertia=[MOMENTS, MOMENTS]), r"inertia must describe one body"),
 ]
@@ -242,15 +304,18 @@ def test_fit_input_error_is_a_value_error():
     assert ep.estimation.FitInputError is FitInputError
 
 
-@pytest.mark.parametrize("kw, match", [
-    pytest.param(dict(t=["a"] * 11, attitude=Q11), r"^t must be a real numeric", id="text t"),
-    pytest.param(dict(t=T11 + 0j, attitude=Q11), r"^t must be real", id="complex t"),
-    pytest.param(dict(attitude=[["a"] * 4] * 11), r"^attitude must be a real numeric", id="text attitude"),
-    pytest.param(dict(attitude=object()), r"^attitude must be", id="object attitude"),
-    pytest.param(dict(omega=np.full((11, 3), "x")), r"^omega must be", id="text omega"),
-    pytest.param(dict(attitude=Q11, attitude_sigma="x"), r"^attitude_sigma must be numeric", id="text sigma"),
-    pytest.param(dict(attitude=Q11, initial=[1.0, 2.0]), r"^initial must be a dict", id="initial list"),
-])
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        pytest.param(dict(t=["a"] * 11, attitude=Q11), r"^t must be a real numeric", id="text t"),
+        pytest.param(dict(t=T11 + 0j, attitude=Q11), r"^t must be real", id="complex t"),
+        pytest.param(dict(attitude=[["a"] * 4] * 11), r"^attitude must be a real numeric", id="text attitude"),
+        pytest.param(dict(attitude=object()), r"^attitude must be", id="object attitude"),
+        pytest.param(dict(omega=np.full((11, 3), "x")), r"^omega must be", id="text omega"),
+        pytest.param(dict(attitude=Q11, attitude_sigma="x"), r"^attitude_sigma must be numeric", id="text sigma"),
+        pytest.param(dict(attitude=Q11, initial=[1.0, 2.0]), r"^initial must be a dict", id="initial list"),
+    ],
+)
 def test_non_numeric_input_raises_type_error(kw, match):
     kw = dict(kw)
     t = kw.pop("t", T11)
@@ -287,6 +352,7 @@ def test_max_iter_zero_reports_not_converged():
 
 # ----------------------------------------------------------------------------
 # 2. inputs accepted
+
 
 def test_attitude_object_and_scipy_rotation_are_converted_right():
     t = np.linspace(0.0, 8.0, 25)
@@ -400,8 +466,9 @@ def test_space_frame_rates_agree_with_body_frame_rates():
     qn = _noisy_attitude(q, 2e-3, rng)
     noise = 2e-3 * rng.standard_normal(w.shape)
     body = ep.fit(t, attitude=qn, attitude_sigma=2e-3, omega=w + noise, omega_sigma=2e-3)
-    space = ep.fit(t, attitude=qn, attitude_sigma=2e-3, omega=_space(q, w) + noise, omega_sigma=2e-3,
-                   omega_frame="space")
+    space = ep.fit(
+        t, attitude=qn, attitude_sigma=2e-3, omega=_space(q, w) + noise, omega_sigma=2e-3, omega_frame="space"
+    )
     truth = dict(I_xx=0.25, I_yy=0.33, omega0_x=W0[0], omega0_y=W0[1], omega0_z=W0[2])
     for name, value in truth.items():
         err = np.hypot(body.stderr[name], space.stderr[name])
@@ -451,8 +518,15 @@ def test_axis_direction_and_space_rates():
     t = np.linspace(0.0, 10.0, 41)
     q, w = _motion(MOMENTS, t)
     d = _matrix(q) @ A_BODY
-    res = ep.fit(t, axis=A_BODY * 3.0, axis_direction=d, axis_sigma=1e-3, omega=_space(q, w), omega_sigma=1e-3,
-                 omega_frame="space")  # the axis need not be unit
+    res = ep.fit(
+        t,
+        axis=A_BODY * 3.0,
+        axis_direction=d,
+        axis_sigma=1e-3,
+        omega=_space(q, w),
+        omega_sigma=1e-3,
+        omega_frame="space",
+    )  # the axis need not be unit
     assert res.chi2 < 1e-15
     _assert_recovers(res, MOMENTS, W0, Q0)
 
@@ -460,8 +534,10 @@ def test_axis_direction_and_space_rates():
 def test_fixed_inertia():
     t = np.linspace(0.0, 8.0, 25)
     q, w = _motion(MOMENTS, t)
-    fits = [ep.fit(t, attitude=q, attitude_sigma=1e-3, inertia=i)
-            for i in (MOMENTS, 100 * MOMENTS, np.diag(MOMENTS), ep.RigidBody(7 * MOMENTS))]
+    fits = [
+        ep.fit(t, attitude=q, attitude_sigma=1e-3, inertia=i)
+        for i in (MOMENTS, 100 * MOMENTS, np.diag(MOMENTS), ep.RigidBody(7 * MOMENTS))
+    ]
     for r in fits:
         assert r.parameter_names == ("attitude0_x", "attitude0_y", "attitude0_z", "omega0_x", "omega0_y", "omega0_z")
         assert not any(k.startswith("I_") for k in r.parameters) and not any(k.startswith("I_") for k in r.stderr)
@@ -505,6 +581,7 @@ def test_full_tensor_principal_axes_fit():
 
 # ----------------------------------------------------------------------------
 # 3. the result
+
 
 def test_result_types(noisy):
     res, _ = noisy
@@ -586,10 +663,29 @@ def test_to_json(noisy, tmp_path):
     res, _ = noisy
     text = res.to_json()
     d = json.loads(text)
-    assert set(d) == {"epoch", "inertia", "principal_moments", "principal_axes", "attitude0", "omega0", "mode",
-                      "parameters", "stderr", "parameter_names", "covariance", "chi2", "dof", "reduced_chi2", "sigma",
-                      "sigma_estimated", "converged", "principal_axes_mode", "n_observations", "local_optima",
-                      "rms_residuals"}
+    assert set(d) == {
+        "epoch",
+        "inertia",
+        "principal_moments",
+        "principal_axes",
+        "attitude0",
+        "omega0",
+        "mode",
+        "parameters",
+        "stderr",
+        "parameter_names",
+        "covariance",
+        "chi2",
+        "dof",
+        "reduced_chi2",
+        "sigma",
+        "sigma_estimated",
+        "converged",
+        "principal_axes_mode",
+        "n_observations",
+        "local_optima",
+        "rms_residuals",
+    }
     assert d["epoch"] == res.epoch and d["chi2"] == res.chi2 and d["dof"] == res.dof
     assert np.array_equal(d["inertia"], res.inertia) and np.array_equal(d["omega0"], res.omega0)
     assert np.array_equal(d["attitude0"], res.attitude0.as_quaternion())
@@ -638,8 +734,10 @@ def test_local_optima_sorted_best_first(noisy):
 
 def test_body_and_mode():
     t = np.linspace(0.0, 15.0, 40)
-    for moments, w0, mode in (([0.21, 0.37, 0.42], [1.0, 0.25, -0.2], "LAM"),
-                              ([0.24, 0.33, 0.43], [0.15, -0.25, 1.0], "SAM")):
+    for moments, w0, mode in (
+        ([0.21, 0.37, 0.42], [1.0, 0.25, -0.2], "LAM"),
+        ([0.24, 0.33, 0.43], [0.15, -0.25, 1.0], "SAM"),
+    ):
         assert _regime(moments, np.array(w0)) == mode
         q, w = _motion(moments, t, omega0=w0)
         res = ep.fit(t, attitude=q, attitude_sigma=1e-3, omega=w, omega_sigma=1e-3)
@@ -727,6 +825,7 @@ def test_sigma_estimate_with_residuals_exactly_zero():
 # ----------------------------------------------------------------------------
 # 4. noise-free recovery from the default starts
 
+
 def _separatrix_w0(moments, factor):
     a, b, c = moments
     w1 = 0.62
@@ -736,10 +835,20 @@ def _separatrix_w0(moments, factor):
 REGIMES = [
     ("LAM", [0.21, 0.37, 0.42], [1.0, 0.25, -0.2], np.linspace(0.0, 15.0, 40), "LAM"),
     ("SAM", [0.24, 0.33, 0.43], [0.15, -0.25, 1.0], np.linspace(0.0, 15.0, 40), "SAM"),
-    ("separatrix, SAM side", [0.22, 0.34, 0.44], _separatrix_w0([0.22, 0.34, 0.44], 1.001),
-     np.linspace(0.0, 15.0, 40), "SAM"),
-    ("separatrix, LAM side", [0.22, 0.34, 0.44], _separatrix_w0([0.22, 0.34, 0.44], 0.999),
-     np.linspace(0.0, 15.0, 40), "LAM"),
+    (
+        "separatrix, SAM side",
+        [0.22, 0.34, 0.44],
+        _separatrix_w0([0.22, 0.34, 0.44], 1.001),
+        np.linspace(0.0, 15.0, 40),
+        "SAM",
+    ),
+    (
+        "separatrix, LAM side",
+        [0.22, 0.34, 0.44],
+        _separatrix_w0([0.22, 0.34, 0.44], 0.999),
+        np.linspace(0.0, 15.0, 40),
+        "LAM",
+    ),
     ("nearly oblate", [0.3, 0.3001, 0.3999], [0.3, 0.1, 1.0], np.linspace(0.0, 15.0, 40), "SAM"),
     ("nearly prolate", [0.3, 0.35, 0.35001], [1.0, 0.3, 0.1], np.linspace(0.0, 15.0, 40), "LAM"),
     ("moments in another order", [0.43, 0.24, 0.33], [1.0, 0.15, -0.25], np.linspace(0.0, 15.0, 40), "SAM"),
@@ -825,8 +934,12 @@ def test_aliased_sparse_attitudes_are_a_known_limitation():
     q, _ = _motion(moments, t, omega0=w0)
     # two exact fits from two starts: the truth and the alias
     truth = ep.fit(t, attitude=q, attitude_sigma=1e-3, initial={"inertia": moments, "omega0": w0 * 1.001})
-    alias = ep.fit(t, attitude=q, attitude_sigma=1e-3,
-                   initial={"inertia": [0.233, 0.328, 0.439], "omega0": [-0.112, 0.182, -0.708]})
+    alias = ep.fit(
+        t,
+        attitude=q,
+        attitude_sigma=1e-3,
+        initial={"inertia": [0.233, 0.328, 0.439], "omega0": [-0.112, 0.182, -0.708]},
+    )
     assert truth.chi2 < 1e-12 and alias.chi2 < 1e-12
     _assert_recovers(truth, moments, w0, Q0)
     assert np.abs(alias.inertia - _trace1(moments)).max() > 5e-3
@@ -858,14 +971,19 @@ def test_initial_attitude_accepts_attitude_objects(kind):
 def test_initial_start_only():
     t = np.linspace(0.0, 10.0, 31)
     q, _ = _motion(MOMENTS, t)
-    res = ep.fit(t, attitude=q, attitude_sigma=1e-3,
-                 initial={"inertia": np.diag([0.26, 0.32, 0.42]) * 5, "omega0": [0.12, 0.18, 1.01]})
+    res = ep.fit(
+        t,
+        attitude=q,
+        attitude_sigma=1e-3,
+        initial={"inertia": np.diag([0.26, 0.32, 0.42]) * 5, "omega0": [0.12, 0.18, 1.01]},
+    )
     assert res.n_starts == 1
     _assert_recovers(res, MOMENTS, W0, Q0)
 
 
 # ----------------------------------------------------------------------------
 # 5. plots
+
 
 @pytest.fixture
 def plt():
@@ -918,6 +1036,7 @@ def test_plots_of_rates_only_and_full_tensor_fits(plt, tmp_path):
 
 # ----------------------------------------------------------------------------
 # 6. property: random bodies and states, noise-free
+
 
 @st.composite
 def _cases(draw):

@@ -38,19 +38,39 @@ def _rhs(t, y, I, Iinv):
 
 
 def _truth_motion(I, q0, w0, t):
-    sol = solve_ivp(_rhs, (t[0], t[-1]), np.concatenate([w0, q0]), method="DOP853", t_eval=t, rtol=1e-13,
-                    atol=1e-13, args=(I, np.linalg.inv(I)))
+    sol = solve_ivp(
+        _rhs,
+        (t[0], t[-1]),
+        np.concatenate([w0, q0]),
+        method="DOP853",
+        t_eval=t,
+        rtol=1e-13,
+        atol=1e-13,
+        args=(I, np.linalg.inv(I)),
+    )
     assert sol.success
     q = sol.y[3:].T
     return q / np.linalg.norm(q, axis=1, keepdims=True), sol.y[:3].T
 
 
 def _qmul(p, q):
-    return np.stack([p[..., 0] * q[..., 0] - np.sum(p[..., 1:] * q[..., 1:], -1),
-                     *(p[..., :1] * q[..., 1:] + q[..., :1] * p[..., 1:] + np.cross(p[..., 1:], q[..., 1:])).T], -1) \
-        if p.ndim == 1 else np.concatenate([
-            (p[..., 0] * q[..., 0] - np.sum(p[..., 1:] * q[..., 1:], -1))[..., None],
-            p[..., :1] * q[..., 1:] + q[..., :1] * p[..., 1:] + np.cross(p[..., 1:], q[..., 1:])], -1)
+    return (
+        np.stack(
+            [
+                p[..., 0] * q[..., 0] - np.sum(p[..., 1:] * q[..., 1:], -1),
+                *(p[..., :1] * q[..., 1:] + q[..., :1] * p[..., 1:] + np.cross(p[..., 1:], q[..., 1:])).T,
+            ],
+            -1,
+        )
+        if p.ndim == 1
+        else np.concatenate(
+            [
+                (p[..., 0] * q[..., 0] - np.sum(p[..., 1:] * q[..., 1:], -1))[..., None],
+                p[..., :1] * q[..., 1:] + q[..., :1] * p[..., 1:] + np.cross(p[..., 1:], q[..., 1:]),
+            ],
+            -1,
+        )
+    )
 
 
 def _noisy(q, w, rng):
@@ -130,8 +150,15 @@ def test_default_starts_find_the_truth_within_3_sigma(truths, name):
     rng = np.random.default_rng(100)
     qo, wo = _noisy(q, w, rng)
     res = ep.fit(t, attitude=qo, attitude_sigma=SA, omega=wo, omega_sigma=SW, principal_axes=axes)
-    at_truth = ep.fit(t, attitude=qo, attitude_sigma=SA, omega=wo, omega_sigma=SW, principal_axes=axes,
-                      initial={"inertia": I / np.trace(I), "omega0": w0, "attitude0": q0})
+    at_truth = ep.fit(
+        t,
+        attitude=qo,
+        attitude_sigma=SA,
+        omega=wo,
+        omega_sigma=SW,
+        principal_axes=axes,
+        initial={"inertia": I / np.trace(I), "omega0": w0, "attitude0": q0},
+    )
     assert res.chi2 <= at_truth.chi2 * (1 + 1e-9) + 1e-9
     z = _param_truth(name, I, q0, w0, res)
     assert len(z) == len(res.parameter_names)
@@ -151,8 +178,9 @@ def calibration(truths):
         z, chi2 = {}, []
         for _ in range(N_CALIBRATION):
             qo, wo = _noisy(q, w, rng)
-            res = ep.fit(t, attitude=qo, attitude_sigma=SA, omega=wo, omega_sigma=SW, principal_axes=axes,
-                         initial=start)
+            res = ep.fit(
+                t, attitude=qo, attitude_sigma=SA, omega=wo, omega_sigma=SW, principal_axes=axes, initial=start
+            )
             for k, v in _param_truth(name, I, q0, w0, res).items():
                 z.setdefault(k, []).append(v)
             chi2.append(res.reduced_chi2)

@@ -23,8 +23,12 @@ H = mpmath.mpf("1e-10")
 def _qmul(p, q):
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return [pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw]
+    return [
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    ]
 
 
 def _exp(theta):
@@ -45,9 +49,11 @@ def _log(q):
 
 def _rot(q):
     w, x, y, z = q
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+    return [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
 
 
 def _mv(A, v):
@@ -93,8 +99,17 @@ def _case(frame, mode, rng):
     d /= np.linalg.norm(d, axis=1, keepdims=True)
     qobs[1] = np.nan
     wobs[2] = np.nan
-    obs = observation_set(t, attitude=qobs, attitude_sigma=0.03, omega=wobs, omega_sigma=[0.02, 0.05, 0.1],
-                          omega_frame=frame, axis=[0.3, -0.2, 0.9], axis_direction=d, axis_sigma=np.linspace(0.01, 0.02, n))
+    obs = observation_set(
+        t,
+        attitude=qobs,
+        attitude_sigma=0.03,
+        omega=wobs,
+        omega_sigma=[0.02, 0.05, 0.1],
+        omega_frame=frame,
+        axis=[0.3, -0.2, 0.9],
+        axis_direction=d,
+        axis_sigma=np.linspace(0.01, 0.02, n),
+    )
     layout = Layout(True, mode)
     p = np.array([0.27, 0.34]) if mode == "given" else np.array([0.27, 0.34, 0.02, -0.015, 0.03])
     q0 = np.array([0.8, 0.3, -0.4, 0.33])

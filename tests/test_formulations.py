@@ -331,7 +331,11 @@ def test_symmetric_top_closed_form():
     m = R0 @ M0
     nu = (1 / I3 - 1 / I1) * (a @ M0)
     t = T_EVAL
-    Rt = Rotation.from_rotvec(t[:, None] * m / I1).as_matrix() @ R0 @ Rotation.from_rotvec(nu * t[:, None] * a).as_matrix()
+    Rt = (
+        Rotation.from_rotvec(t[:, None] * m / I1).as_matrix()
+        @ R0
+        @ Rotation.from_rotvec(nu * t[:, None] * a).as_matrix()
+    )
     Mt = np.einsum("tji,j->ti", Rt, m)
     Wt = Mt / I1 + (1 / I3 - 1 / I1) * (Mt @ a)[:, None] * a
     q0 = Rotation.from_matrix(R0).as_quat(scalar_first=True)
@@ -400,7 +404,9 @@ def test_geodesic_acceleration_and_lagrangian(body, states):
     np.testing.assert_allclose(L, 0.5 * np.einsum("...i,...ij,...j->...", v, metric(n, body), v), rtol=1e-13)
     # Legendre: H(n, G ndot) = L(n, ndot)
     can = F.formulation("canonical", body)
-    np.testing.assert_allclose(can.hamiltonian(np.concatenate([n, F.canonical_momentum(n, v, body)], -1)), L, rtol=1e-13)
+    np.testing.assert_allclose(
+        can.hamiltonian(np.concatenate([n, F.canonical_momentum(n, v, body)], -1)), L, rtol=1e-13
+    )
     g = F.formulation("geodesic", body)
     np.testing.assert_allclose(g.momenta(x), F.canonical_momentum(n, v, body), rtol=1e-14)
     np.testing.assert_allclose(g.christoffel(x), Gam, rtol=1e-14)
@@ -500,7 +506,11 @@ def test_paper_eq_1_16_printed_pidot_is_a_misprint(body, states):
     npi = np.sum(n * p, -1)
 
     def pidot(last):
-        K = npi[..., None, None] * np.eye(3) + p[..., :, None] * n[..., None, :] + np.einsum("ijk,...k->...ij", EPS, last)
+        K = (
+            npi[..., None, None] * np.eye(3)
+            + p[..., :, None] * n[..., None, :]
+            + np.einsum("ijk,...k->...ij", EPS, last)
+        )
         return -0.25 * np.einsum("...ij,...j->...i", K, u)
 
     minus_dHdn = -fd_grad(f.hamiltonian, x)[..., :3]
@@ -532,7 +542,9 @@ def test_paper_eq_1_28_and_1_29(body, states):
     M = W @ body.inertia
     s = 1 + np.sum(n * n, -1)
     P = F.formulation("velocity", body).poisson_tensor(x)
-    nW = 0.5 * np.einsum("...ik,kj->...ij", -np.einsum("ikp,...p->...ik", EPS, n) + np.eye(3) + n[..., :, None] * n[..., None, :], Iinv)
+    nW = 0.5 * np.einsum(
+        "...ik,kj->...ij", -np.einsum("ikp,...p->...ik", EPS, n) + np.eye(3) + n[..., :, None] * n[..., None, :], Iinv
+    )
     WW = -np.einsum("ia,jb,...abc,...c->...ij", Iinv, Iinv, EPS + cyclic(n), M) / s[..., None, None]
     np.testing.assert_allclose(P[..., :3, 3:], nW, atol=1e-14)
     np.testing.assert_allclose(P[..., 3:, 3:], WW, atol=1e-13)

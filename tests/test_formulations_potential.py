@@ -181,8 +181,9 @@ def motions():
         sols = {}
         for name in NAMES:
             f = ep.formulation(name, I_GEN, torque=tq)
-            sol = solve_ivp(f.rhs, (0.0, T_EVAL[-1]), f.from_common(Q0, W0), method="DOP853",
-                            t_eval=T_EVAL, rtol=1e-13, atol=1e-13)
+            sol = solve_ivp(
+                f.rhs, (0.0, T_EVAL[-1]), f.from_common(Q0, W0), method="DOP853", t_eval=T_EVAL, rtol=1e-13, atol=1e-13
+            )
             assert sol.success
             sols[name] = sol.y.T
         out[label] = (ref, sols)
@@ -247,8 +248,9 @@ def test_bad_torque_arguments():
     with pytest.raises(TypeError, match="not both"):
         ep.formulation("canonical", ep.Model(I_GEN, TORQUES["gravity"]), torque=TORQUES["gravity"])
     with pytest.raises(InvalidInputError, match="batch shapes"):
-        ep.formulation("canonical", ep.RigidBody(np.stack([I_GEN, I_GEN])),
-                       torque=Gravity([1.0, 2.0, 3.0], [0.0, 0.0, 0.1]))
+        ep.formulation(
+            "canonical", ep.RigidBody(np.stack([I_GEN, I_GEN])), torque=Gravity([1.0, 2.0, 3.0], [0.0, 0.0, 0.1])
+        )
     f = ep.formulation("canonical", I_GEN, torque=TORQUES["gravity_gradient"])
     x = np.zeros(6)
     with pytest.raises(InvalidInputError, match="t must be|t "):
@@ -298,8 +300,11 @@ def test_heavy_top_expressions(D):
     n = sp.Matrix([sp.Rational(1, 3), sp.Rational(-1, 2), sp.Rational(1, 5)])
     at0 = dict(zip(D.n, n))
     s = 1 + (n.T * n)[0]
-    R = ((1 - (n.T * n)[0]) * sp.eye(3) + 2 * n * n.T - 2 * sp.Matrix(3, 3, lambda i, j: sum(
-        sp.LeviCivita(i, j, k) * n[k] for k in range(3)))) / s  # paper eq. 1.9
+    R = (
+        (1 - (n.T * n)[0]) * sp.eye(3)
+        + 2 * n * n.T
+        - 2 * sp.Matrix(3, 3, lambda i, j: sum(sp.LeviCivita(i, j, k) * n[k] for k in range(3)))
+    ) / s  # paper eq. 1.9
     assert sp.simplify(D.R.xreplace(at0) - R) == sp.zeros(3, 3)
     assert sp.expand(D.U.xreplace(at0) + D.mass * (D.g.T * R * D.c)[0]) == 0
 
@@ -312,8 +317,11 @@ def test_heavy_top_matches_numeric_vector_field(D):
         exact = D.evaluate(n, pi, I, mass, c, g, exact=True)
         assert all(isinstance(v, Fraction) for v in exact)
         np.testing.assert_array_equal(derived, [float(v) for v in exact])
-        f = ep.formulation("canonical", np.array(I, dtype=float),
-                           torque=Gravity(float(mass), [float(v) for v in c], [float(v) for v in g]))
+        f = ep.formulation(
+            "canonical",
+            np.array(I, dtype=float),
+            torque=Gravity(float(mass), [float(v) for v in c], [float(v) for v in g]),
+        )
         numeric = f.vector_field(np.array([float(v) for v in n + pi]))
         np.testing.assert_allclose(numeric, derived, rtol=1e-12, atol=1e-12)
     # also from floats (converted exactly)

@@ -96,8 +96,24 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
     shutil.copy(ROOT / "examples" / "run.toml", tmp_path / "run.toml")
     _small_sweep(tmp_path / "examples" / "sweep.toml")
     # the README's 10^8-sample long.zarr, small
-    assert run(capsys, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "100",
-               "--samples", "20000", "--out", "long.zarr", "--quiet")[0] == 0
+    assert (
+        run(
+            capsys,
+            "simulate",
+            "--inertia",
+            "1,2,3",
+            "--omega",
+            "1,0.1,0.5",
+            "--t-end",
+            "100",
+            "--samples",
+            "20000",
+            "--out",
+            "long.zarr",
+            "--quiet",
+        )[0]
+        == 0
+    )
     # the audit of one equation instead of all (25 s each time)
     small = A.run_audit(entries=[e for e in A.ENTRIES if e.equation == "1.12"], integrability=False)
     monkeypatch.setattr(A, "run_audit", lambda **kw: small)
@@ -120,9 +136,21 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
             assert "Traceback" not in err, cmd
             ran.append(cmd)
     assert len(ran) == sum(len(c) for c in EXAMPLES.values()) >= 25
-    for f in ("base/run.nc", "base/top.nc", "base/top_apex.png", "audit/audit.json", "audit/audit.tex",
-              "plot/polhode.pdf", "animate/movie.gif", "sweep/atlas.zarr", "sweep/atlas.png",
-              "sweep/atlas_serial.zarr", "demo/out/tennis_racket.nc", "demo/out/audit.md",
-              "validate/racket_error.png", "cases/cases_csv/sphere.csv"):
+    for f in (
+        "base/run.nc",
+        "base/top.nc",
+        "base/top_apex.png",
+        "audit/audit.json",
+        "audit/audit.tex",
+        "plot/polhode.pdf",
+        "animate/movie.gif",
+        "sweep/atlas.zarr",
+        "sweep/atlas.png",
+        "sweep/atlas_serial.zarr",
+        "demo/out/tennis_racket.nc",
+        "demo/out/audit.md",
+        "validate/racket_error.png",
+        "cases/cases_csv/sphere.csv",
+    ):
         assert (tmp_path / f).exists(), f
     assert ep.Trajectory.open(tmp_path / "base" / "top.nc").model.lagrange_top() is not None

@@ -69,8 +69,14 @@ def test_long_run_and_store_pictures_draw_a_dollar_time_unit_as_typed(tmp_path):
     for kind in ("omega", "invariants"):
         _assert_literal(plots.plot(tr, kind, out=tmp_path / f"m_{kind}.png"), f"[{BAD_TEX}]")
     path = tmp_path / "s.zarr"
-    solve_to_file(ep.RigidBody([1.0, 2.0, 3.0], name=BAD_TEX), (0.0, 30.0, 3001), path, omega0=[1.0, 0.1, 0.5],
-                  progress=False, chunk=1000)
+    solve_to_file(
+        ep.RigidBody([1.0, 2.0, 3.0], name=BAD_TEX),
+        (0.0, 30.0, 3001),
+        path,
+        omega0=[1.0, 0.1, 0.5],
+        progress=False,
+        chunk=1000,
+    )
     lz = ep.Trajectory.open(path)
     lz.options["time_unit"] = TEX
     for kind in ("omega", "invariants"):

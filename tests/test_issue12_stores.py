@@ -66,10 +66,17 @@ def test_direct_reads_equal_zarr_reads(store):
     for name in ("time", "quaternion", "omega", "M", "m", "energy", "gibbs"):
         arr = lz.t if name == "time" else lz.stored(name)
         assert isinstance(R._DirectChunks.of(arr._arr, 0), R._DirectChunks), name
-        cases = [(0, T, 1), (0, 3000, 1), (2999, 3001, 1), (24_000, T, 1), (5, T, 7), (0, T, 3001), (T - 1, T, 1),
-                 (10, 10, 1)]
-        cases += [(int(a), int(a + rng.integers(0, 9000)), int(rng.integers(1, 50)))
-                  for a in rng.integers(0, T, 20)]
+        cases = [
+            (0, T, 1),
+            (0, 3000, 1),
+            (2999, 3001, 1),
+            (24_000, T, 1),
+            (5, T, 7),
+            (0, T, 3001),
+            (T - 1, T, 1),
+            (10, 10, 1),
+        ]
+        cases += [(int(a), int(a + rng.integers(0, 9000)), int(rng.integers(1, 50))) for a in rng.integers(0, T, 20)]
         for a, b, step in cases:
             b = min(b, T)
             got = arr.read(a, b, step)
@@ -115,16 +122,23 @@ def test_unwritten_chunks_read_as_nan_like_zarr(tmp_path):
 
 def test_batched_store_reads_equal_zarr(tmp_path):
     path = tmp_path / "b.zarr"
-    solve_to_file([[1.0, 2.0, 3.0], [2.0, 3.0, 4.0]], (0.0, 5.0, 2_500), path,
-                  omega0=[[1.0, 0.1, 0.5], [0.2, 1.0, 0.3]], chunk=700, progress=False)
+    solve_to_file(
+        [[1.0, 2.0, 3.0], [2.0, 3.0, 4.0]],
+        (0.0, 5.0, 2_500),
+        path,
+        omega0=[[1.0, 0.1, 0.5], [0.2, 1.0, 0.3]],
+        chunk=700,
+        progress=False,
+    )
     lz = ep.Trajectory.open(path)
     assert lz.batch_shape == (2,)
     for a, b, step in ((0, 2_500, 1), (650, 1_450, 3), (2_499, 2_500, 1)):
         got = lz.omega.read(a, b, step)
         assert got.shape == (2, len(range(a, b, step)), 3)
         np.testing.assert_array_equal(got, _zarr_read(path, "omega", a, b, step, axis=1))
-    mem = ep.solve([[1.0, 2.0, 3.0], [2.0, 3.0, 4.0]], np.linspace(0.0, 5.0, 2_500),
-                   omega0=[[1.0, 0.1, 0.5], [0.2, 1.0, 0.3]])
+    mem = ep.solve(
+        [[1.0, 2.0, 3.0], [2.0, 3.0, 4.0]], np.linspace(0.0, 5.0, 2_500), omega0=[[1.0, 0.1, 0.5], [0.2, 1.0, 0.3]]
+    )
     np.testing.assert_array_equal(lz.load().omega, mem.omega)
 
 
@@ -134,10 +148,12 @@ def test_other_layouts_are_read_by_zarr(tmp_path, codecs):
     from zarr.codecs import BloscCodec
 
     x = np.random.default_rng(1).normal(size=(1_000, 3))
-    kw = {"none": {"compressors": None}, "blosc": {"compressors": [BloscCodec()]},
-          "sharded": {"shards": (400, 3)}}[codecs]
-    arr = zarr.create_array(str(tmp_path / "a.zarr"), shape=x.shape, chunks=(100, 3), dtype="f8",
-                            fill_value=np.nan, **kw)
+    kw = {"none": {"compressors": None}, "blosc": {"compressors": [BloscCodec()]}, "sharded": {"shards": (400, 3)}}[
+        codecs
+    ]
+    arr = zarr.create_array(
+        str(tmp_path / "a.zarr"), shape=x.shape, chunks=(100, 3), dtype="f8", fill_value=np.nan, **kw
+    )
     arr[...] = x
     direct = R._DirectChunks.of(arr, 0)
     assert (direct is not None) == (codecs == "none")
@@ -231,10 +247,10 @@ def test_envelope_pieces_in_any_order_and_threads_equal_one_pass():
         k = int(np.flatnonzero(np.unique(col) == c)[0])
         for j in range(3):
             if np.all(np.isnan(sel[:, j])):
-                assert np.isnan(y1[2 * k:2 * k + 2, j]).all()
+                assert np.isnan(y1[2 * k : 2 * k + 2, j]).all()
             else:
-                assert np.nanmin(y1[2 * k:2 * k + 2, j]) == np.nanmin(sel[:, j])
-                assert np.nanmax(y1[2 * k:2 * k + 2, j]) == np.nanmax(sel[:, j])
+                assert np.nanmin(y1[2 * k : 2 * k + 2, j]) == np.nanmin(sel[:, j])
+                assert np.nanmax(y1[2 * k : 2 * k + 2, j]) == np.nanmax(sel[:, j])
 
 
 def test_invariants_of_a_store_equal_those_of_the_run_in_memory(store):
@@ -295,8 +311,9 @@ def test_info_of_an_interrupted_store_says_how_far_and_how_to_resume(capsys, tmp
     for name in ("r.zarr", ".r.zarr.partial/store.zarr", ".r.zarr.partial"):
         code, out, err = run(capsys, "info", name)
         assert code == 0, err
-        assert out.startswith(f"{name}: unfinished run to r.zarr (interrupted): 2 of 3 chunks finished, "
-                              f"200000 of {n} samples"), out
+        assert out.startswith(
+            f"{name}: unfinished run to r.zarr (interrupted): 2 of 3 chunks finished, 200000 of {n} samples"
+        ), out
         grid = TimeGrid(0.0, t_end, n)
         assert f"samples 0 to 199999: t from 0 to {grid[199_999:200_000][0]:.6g}" in out
         assert ("Gravity(" in out) == (case == "top") and ".r.zarr.partial/store.zarr" in out
@@ -318,8 +335,22 @@ def test_info_of_an_interrupted_store_says_how_far_and_how_to_resume(capsys, tmp
 def test_info_of_a_killed_simulate(capsys, tmp_path):
     """A real 'simulate' killed (SIGKILL) between chunks: info describes it, its resume command finishes it."""
     store = tmp_path / "k.zarr"
-    argv = [EXE, "simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "2000", "--samples",
-            "4000000", "--method", "taylor", "--out", str(store)]
+    argv = [
+        EXE,
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "2000",
+        "--samples",
+        "4000000",
+        "--method",
+        "taylor",
+        "--out",
+        str(store),
+    ]
     proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     done = tmp_path / ".k.zarr.partial" / "done"
     try:
@@ -336,8 +367,11 @@ def test_info_of_a_killed_simulate(capsys, tmp_path):
         proc.wait(timeout=60)
     code, out, err = run(capsys, "info", store)
     assert code == 0, err
-    m = re.match(rf"{re.escape(str(store))}: unfinished run to {re.escape(str(store))} \(interrupted\): "
-                 r"(\d+) of 40 chunks finished, (\d+) of 4000000 samples", out)
+    m = re.match(
+        rf"{re.escape(str(store))}: unfinished run to {re.escape(str(store))} \(interrupted\): "
+        r"(\d+) of 40 chunks finished, (\d+) of 4000000 samples",
+        out,
+    )
     assert m and int(m.group(1)) >= 2 and int(m.group(2)) == 100_000 * int(m.group(1)), out
     cmd = _resume_line(out)
     assert cmd == shlex.join(["eulerpoisson", *argv[1:]])  # the very command that was killed
@@ -368,8 +402,9 @@ def test_info_of_runs_it_cannot_rebuild_or_that_never_started(capsys, tmp_path, 
     # a finished store and an unfinished run to replace it (simulate --overwrite)
     solve_to_file(I123, (0.0, 1.0, 11), "both.zarr", omega0=W0, progress=False)
     with pytest.raises(KeyboardInterrupt):
-        solve_to_file(I123, (0.0, 10.0, 5_000), "both.zarr", omega0=W0, chunk=1_000, progress=_Stop(1_000),
-                      overwrite=True)
+        solve_to_file(
+            I123, (0.0, 10.0, 5_000), "both.zarr", omega0=W0, chunk=1_000, progress=_Stop(1_000), overwrite=True
+        )
     code, out, err = run(capsys, "info", "both.zarr")
     assert code == 0 and "samples     11," in out and "an unfinished run to replace it" in out
     code, out, err = run(capsys, "info", ".both.zarr.partial/store.zarr")

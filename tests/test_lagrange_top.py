@@ -87,12 +87,14 @@ SEPARATRIX = {
 def _qmul(a, b):
     aw, ax, ay, az = a
     bw, bx, by, bz = b
-    return np.array([
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ])
+    return np.array(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ]
+    )
 
 
 def _conj(q):
@@ -116,8 +118,16 @@ def _dop853(case, t):
         if np.any(sel):
             ts = t[sel]
             order = np.argsort(np.abs(ts))
-            sol = solve_ivp(_rhs, (0.0, ts[order][-1]), y0, method="DOP853", rtol=1e-13, atol=1e-13,
-                            t_eval=ts[order], args=(A, C, mass, ell, np.asarray(g, float)))
+            sol = solve_ivp(
+                _rhs,
+                (0.0, ts[order][-1]),
+                y0,
+                method="DOP853",
+                rtol=1e-13,
+                atol=1e-13,
+                t_eval=ts[order],
+                args=(A, C, mass, ell, np.asarray(g, float)),
+            )
             res = np.empty((len(ts), 7))
             res[order] = sol.y.T
             out[sel] = res
@@ -143,8 +153,10 @@ def _mp_taylor(case, t_end, dps=34, order=24, h=0.1):
             W = [[v] for v in w]
             Gs = [[] for _ in range(4)]
             for k in range(order):
+
                 def cp(a, b, k=k):
                     return mp.fsum(a[i] * b[k - i] for i in range(k + 1))
+
                 qd = [
                     -(cp(Q[1], W[0]) + cp(Q[2], W[1]) + cp(Q[3], W[2])),
                     cp(Q[0], W[0]) + cp(Q[2], W[2]) - cp(Q[3], W[1]),
@@ -177,6 +189,7 @@ def _mp_taylor(case, t_end, dps=34, order=24, h=0.1):
                 for v in reversed(c):
                     s = s * hh + v
                 return s
+
             q = [ev(c) for c in Q]
             w = [ev(c) for c in W]
         return np.array([float(v) for v in q]), np.array([float(v) for v in w])
@@ -259,8 +272,16 @@ def test_separatrix_closed_form():
 # ---------------------------------------------------------------------------
 @pytest.mark.parametrize(
     "name",
-    ["nutation", "looping", "oblique_gravity", "through_bottom", "pendulum_from_rest", "free_ell_zero",
-     "near_vertical", "spherical_A_eq_C"],
+    [
+        "nutation",
+        "looping",
+        "oblique_gravity",
+        "through_bottom",
+        "pendulum_from_rest",
+        "free_ell_zero",
+        "near_vertical",
+        "spherical_A_eq_C",
+    ],
 )
 def test_conservation_long_time(name):
     case = CASES[name]
@@ -370,8 +391,14 @@ def test_free_top_explicit():
     np.testing.assert_array_equal(om1, om3)
     # body angular velocity rotates about e3 at rate Omega3 (A - C)/A, |Omega_perp| fixed
     b = om0[2] * (A - C) / A
-    ref = np.stack([om0[0] * np.cos(b * t) + om0[1] * np.sin(b * t),
-                    -om0[0] * np.sin(b * t) + om0[1] * np.cos(b * t), np.full_like(t, om0[2])], axis=-1)
+    ref = np.stack(
+        [
+            om0[0] * np.cos(b * t) + om0[1] * np.sin(b * t),
+            -om0[0] * np.sin(b * t) + om0[1] * np.cos(b * t),
+            np.full_like(t, om0[2]),
+        ],
+        axis=-1,
+    )
     np.testing.assert_allclose(om1, ref, atol=1e-14)
 
 
@@ -391,6 +418,7 @@ def test_extreme_gravity_scales(gz):
         case_n = (A, C, mass, ell, [0.0, 0.0, -1.0], q0, om0)  # invariants with unit g
         e0, m0, _ = _invariants(case_n, np.asarray(q0), np.asarray(om0, float))
         E, mg, _ = _invariants(case_n, q, om)
+
         # E computed with g=1: kinetic + gz * potential; compare the total energy
         def pot(qq):
             return -mass * np.sum(np.array([0, 0, -1.0]) * _rot(qq, np.array([0.0, 0.0, ell])), -1)
@@ -402,8 +430,9 @@ def test_extreme_gravity_scales(gz):
         np.testing.assert_allclose(mg, m0, rtol=0, atol=1e-13 * np.sqrt((abs(kin0) + gz * mass * ell) * C))
 
 
-@pytest.mark.parametrize("name", ["sleeping_stable", "sleeping_unstable", "hanging_spin", "upright_equilibrium",
-                                  "hanging_equilibrium"])
+@pytest.mark.parametrize(
+    "name", ["sleeping_stable", "sleeping_unstable", "hanging_spin", "upright_equilibrium", "hanging_equilibrium"]
+)
 def test_sleeping_and_equilibria(name):
     """u = +-1 for all time: q(t) = q0 q_z(Omega3 t)."""
     A, C, mass, ell, g, q0, om0 = CASES[name]
@@ -418,8 +447,9 @@ def test_sleeping_and_equilibria(name):
 # ---------------------------------------------------------------------------
 # bad input
 # ---------------------------------------------------------------------------
-_GOOD = dict(A=1.0, C=0.6, mass=1.0, ell=0.4, g=G, q0=[1.0, 0.0, 0.0, 0.0], omega0=[0.1, 0.2, 3.0],
-             t=np.array([0.0, 1.0]))
+_GOOD = dict(
+    A=1.0, C=0.6, mass=1.0, ell=0.4, g=G, q0=[1.0, 0.0, 0.0, 0.0], omega0=[0.1, 0.2, 3.0], t=np.array([0.0, 1.0])
+)
 
 
 @pytest.mark.parametrize(

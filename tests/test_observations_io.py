@@ -25,8 +25,16 @@ def _random_dirs(rng, n):
 def _write_csv(path, header, rows, comments=()):
     lines = [f"# {c}" for c in comments] + [",".join(header)]
     for row in rows:
-        lines.append(",".join("" if (isinstance(v, float) and math.isnan(v)) else repr(float(v)) if
-                              isinstance(v, (float, np.floating)) else str(v) for v in row))
+        lines.append(
+            ",".join(
+                ""
+                if (isinstance(v, float) and math.isnan(v))
+                else repr(float(v))
+                if isinstance(v, (float, np.floating))
+                else str(v)
+                for v in row
+            )
+        )
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -49,8 +57,24 @@ def test_csv_round_trip_all_columns(tmp_path, rng):
     s_att = rng.uniform(0.01, 1.0, n)
     s_w = rng.uniform(0.01, 1.0, (n, 3))
     s_ax = rng.uniform(0.01, 1.0, n)
-    header = ["t", "qw", "qx", "qy", "qz", "wx", "wy", "wz", "ax", "ay", "az",
-              "sigma_attitude_deg", "sigma_wx", "sigma_wy", "sigma_wz", "sigma_axis_deg"]
+    header = [
+        "t",
+        "qw",
+        "qx",
+        "qy",
+        "qz",
+        "wx",
+        "wy",
+        "wz",
+        "ax",
+        "ay",
+        "az",
+        "sigma_attitude_deg",
+        "sigma_wx",
+        "sigma_wy",
+        "sigma_wz",
+        "sigma_axis_deg",
+    ]
     rows = np.column_stack([t, q, w, a, s_att, s_w, s_ax])
     p = _write_csv(tmp_path / "obs.csv", header, rows, comments=["star tracker + gyro + sun sensor"])
     obs = read_observations(p, axis=[0, 0, 2])
@@ -70,16 +94,19 @@ def test_csv_round_trip_all_columns(tmp_path, rng):
 
 
 def test_csv_missing_cells_comments_and_sigma_nan_where_missing(tmp_path):
-    p = _csv(tmp_path, (
-        "\ufeff# a comment before the header\n"
-        "\n"
-        "t, qw, qx, qy, qz, wx, wy, wz, sigma_attitude_deg, sigma_omega\r\n"
-        "0.0,1,0,0,0,0.10,0.02,0.50,0.05,0.01\r\n"
-        "   # a comment between rows\n"
-        '0.5,"0.9689",0.0125,0.0081,0.2470,nan,NAN,NaN,0.05,\n'
-        "1.0,,,,,0.09,0.04,0.49,,0.02\n"
-        "1.5,nan,nan,nan,nan,,,,-1,\n"
-    ))
+    p = _csv(
+        tmp_path,
+        (
+            "\ufeff# a comment before the header\n"
+            "\n"
+            "t, qw, qx, qy, qz, wx, wy, wz, sigma_attitude_deg, sigma_omega\r\n"
+            "0.0,1,0,0,0,0.10,0.02,0.50,0.05,0.01\r\n"
+            "   # a comment between rows\n"
+            '0.5,"0.9689",0.0125,0.0081,0.2470,nan,NAN,NaN,0.05,\n'
+            "1.0,,,,,0.09,0.04,0.49,,0.02\n"
+            "1.5,nan,nan,nan,nan,,,,-1,\n"
+        ),
+    )
     obs = read_observations(p)
     np.testing.assert_array_equal(obs.t, [0.0, 0.5, 1.0, 1.5])
     assert np.isnan(obs.attitude[2:]).all() and np.isfinite(obs.attitude[:2]).all()
@@ -131,8 +158,11 @@ def test_csv_columns_in_any_order_and_only_some_groups(tmp_path):
 
 
 def test_sigma_keywords_override_file_columns(tmp_path):
-    p = _csv(tmp_path, "t,qw,qx,qy,qz,wx,wy,wz,ax,ay,az,sigma_attitude_deg,sigma_omega,sigma_axis_deg\n"
-                       "0,1,0,0,0,1,2,3,0,0,1,0.1,0.2,0.3\n1,1,0,0,0,1,2,3,0,1,0,0.1,0.2,0.3\n")
+    p = _csv(
+        tmp_path,
+        "t,qw,qx,qy,qz,wx,wy,wz,ax,ay,az,sigma_attitude_deg,sigma_omega,sigma_axis_deg\n"
+        "0,1,0,0,0,1,2,3,0,0,1,0.1,0.2,0.3\n1,1,0,0,0,1,2,3,0,1,0,0.1,0.2,0.3\n",
+    )
     obs = read_observations(p, axis=(1, 0, 0), sigma_attitude_deg=2.0, sigma_omega=0.5, sigma_axis_deg=3)
     assert obs.attitude_sigma == pytest.approx(2.0 * DEG) and isinstance(obs.attitude_sigma, float)
     assert obs.omega_sigma == 0.5
@@ -175,8 +205,11 @@ CSV_ERRORS = [
     ("t\n0\n1\n", {}, r"no observation columns"),
     (Q + "0,1,0,0,0\n1,1,x,0,0\n", {}, r"obs\.csv, line 3, column 'qx': 'x' is not a number"),
     (Q + "0,1,0,0,0\n1,1,1_0,0,0\n", {}, r"line 3, column 'qx': '1_0' is not a number"),
-    (Q + "0,1,0,0,0\n2,1,0,0,0\n1,1,0,0,0\n", {},
-     r"line 4: time t = 1\.0 is before t = 2\.0 at line 3; times must be strictly increasing"),
+    (
+        Q + "0,1,0,0,0\n2,1,0,0,0\n1,1,0,0,0\n",
+        {},
+        r"line 4: time t = 1\.0 is before t = 2\.0 at line 3; times must be strictly increasing",
+    ),
     (Q + "0,1,0,0,0\n# c\n0,1,0,0,0\n", {}, r"line 4: duplicate time t = 0\.0 \(also at line 2\)"),
     (Q + "0,1,0,0,0\ninf,1,0,0,0\n", {}, r"line 3, column 't': the time is inf, not finite"),
     (Q + "0,1,0,0,0\n,1,0,0,0\n", {}, r"line 3, column 't': the time is missing"),
@@ -184,26 +217,48 @@ CSV_ERRORS = [
     (Q + "0,1,0,0,0\n1,1.00001,0,0,0\n", {}, r"line 3: the quaternion .* has norm 1\.00001, not 1 \(tolerance 1e-06\)"),
     (Q + "0,0,0,0,0\n", {}, r"line 2: the quaternion is the zero vector"),
     (Q + "0,1,0,0,0\n1,1,0,,0\n", {}, r"line 3: the quaternion is partly missing \(column 'qy' empty/NaN"),
-    ("t,qw,qx,qy,qz,euler_ZXZ_1,euler_ZXZ_2,euler_ZXZ_3\n0,1,0,0,0,0,0,0\n", {},
-     r"both quaternion columns \(qw, qx, qy, qz\) and Euler angle columns \(euler_ZXZ_\*\)"),
-    ("t,euler_ZXZ_1,euler_ZXZ_2,euler_xyz_1,euler_xyz_2,euler_xyz_3\n0,0,0,0,0,0\n", {},
-     r"Euler angles in more than one sequence \(ZXZ, xyz\)"),
+    (
+        "t,qw,qx,qy,qz,euler_ZXZ_1,euler_ZXZ_2,euler_ZXZ_3\n0,1,0,0,0,0,0,0\n",
+        {},
+        r"both quaternion columns \(qw, qx, qy, qz\) and Euler angle columns \(euler_ZXZ_\*\)",
+    ),
+    (
+        "t,euler_ZXZ_1,euler_ZXZ_2,euler_xyz_1,euler_xyz_2,euler_xyz_3\n0,0,0,0,0,0\n",
+        {},
+        r"Euler angles in more than one sequence \(ZXZ, xyz\)",
+    ),
     ("t,euler_ZXZ_1,euler_ZXZ_2\n0,0,0\n", {}, r"columns euler_ZXZ_1, euler_ZXZ_2 without euler_ZXZ_3"),
-    ("t,euler_ZZX_1,euler_ZZX_2,euler_ZZX_3\n0,0,0,0\n", {},
-     r"column 'euler_ZZX_1': invalid Euler sequence: .*consecutive axes must differ"),
+    (
+        "t,euler_ZZX_1,euler_ZZX_2,euler_ZZX_3\n0,0,0,0\n",
+        {},
+        r"column 'euler_ZZX_1': invalid Euler sequence: .*consecutive axes must differ",
+    ),
     ("t,euler_ZxZ_1,euler_ZxZ_2,euler_ZxZ_3\n0,0,0,0\n", {}, r"euler_ZxZ_1.*mixes lower case"),
-    ("t,euler_XYZ_1,euler_XYZ_2,euler_XYZ_3\n0,0,0,0\n1,0,,0\n", {},
-     r"line 3: the Euler angles \(XYZ\) is partly missing \(column 'euler_XYZ_2'"),
-    ("t,ax,ay,az\n0,0,0,1\n", {},
-     r"columns ax, ay, az give the space direction of a body axis, but not which axis: pass axis="),
+    (
+        "t,euler_XYZ_1,euler_XYZ_2,euler_XYZ_3\n0,0,0,0\n1,0,,0\n",
+        {},
+        r"line 3: the Euler angles \(XYZ\) is partly missing \(column 'euler_XYZ_2'",
+    ),
+    (
+        "t,ax,ay,az\n0,0,0,1\n",
+        {},
+        r"columns ax, ay, az give the space direction of a body axis, but not which axis: pass axis=",
+    ),
     ("t,wx,wy,wz\n0,1,2,3\n", {"axis": [0, 0, 1]}, r"axis=\[0\.0, 0\.0, 1\.0\] is given, but .*obs\.csv has no axis"),
     ("t,ax,ay,az\n0,0,0,1\n1,0,0,0\n", {"axis": [0, 0, 1]}, r"line 3: the axis direction is the zero vector"),
-    ("t,ax,ay,az\n0,0,0,1\n1,0,0.5,0.5\n", {"axis": [0, 0, 1]},
-     r"line 3: the axis direction \[0\.0, 0\.5, 0\.5\] has norm 0\.7071067812, not 1"),
+    (
+        "t,ax,ay,az\n0,0,0,1\n1,0,0.5,0.5\n",
+        {"axis": [0, 0, 1]},
+        r"line 3: the axis direction \[0\.0, 0\.5, 0\.5\] has norm 0\.7071067812, not 1",
+    ),
     ("t,wx,wy,wz\n0,1,2,3\n", {"omega_frame": "inertial"}, r"omega_frame must be 'body' or 'space', got 'inertial'"),
-    ("t,wx,wy,wz,qW\n0,1,2,3,4\n", {}, r"line 1: unknown column 'qW' \(did you mean 'qw'\? names are case sensitive\); "
-     r"known columns: t, qw, qx, qy, qz, euler_SEQ_1, euler_SEQ_2, euler_SEQ_3, wx, wy, wz, ax, ay, az, "
-     r"sigma_attitude_deg, sigma_omega, sigma_wx, sigma_wy, sigma_wz, sigma_axis_deg$"),
+    (
+        "t,wx,wy,wz,qW\n0,1,2,3,4\n",
+        {},
+        r"line 1: unknown column 'qW' \(did you mean 'qw'\? names are case sensitive\); "
+        r"known columns: t, qw, qx, qy, qz, euler_SEQ_1, euler_SEQ_2, euler_SEQ_3, wx, wy, wz, ax, ay, az, "
+        r"sigma_attitude_deg, sigma_omega, sigma_wx, sigma_wy, sigma_wz, sigma_axis_deg$",
+    ),
     ("t,wx,wy,wz,sigma_w\n0,1,2,3,4\n", {}, r"unknown column 'sigma_w' \(sigma columns are sigma_attitude_deg, "),
     ("t,wx,wy,wz,euler_1\n0,1,2,3,4\n", {}, r"unknown column 'euler_1' \(Euler angle columns are euler_SEQ_1, "),
     ("t,wx,wy,wz,wx\n0,1,2,3,4\n", {}, r"column 'wx' appears twice in the header"),
@@ -212,18 +267,33 @@ CSV_ERRORS = [
     ("# only a comment\n\n", {}, r"no header row"),
     ("t,wx,wy,wz\n# no data\n", {}, r"no data rows after the header \(line 1\)"),
     ("t,wx,wy,wz\n0,1,inf,3\n", {}, r"line 2, column 'wy': value inf is not finite"),
-    ("t,wx,wy,wz,sigma_omega\n0,1,2,3,0\n", {},
-     r"line 2, column 'sigma_omega': sigma is 0\.0; a sigma must be positive and finite where its observation"),
-    ("t,wx,wy,wz\n0,1,2,3\n1,1,,3\n", {},
-     r"line 3: the angular velocity is partly missing \(column 'wy' empty/NaN, the rest given in columns wx, wy, wz\)"),
-    ("t,wx,wy,wz,sigma_wx,sigma_wy,sigma_wz\n0,,,,1,,1\n1,1,2,3,1,,1\n", {},
-     r"line 3, column 'sigma_wy': sigma is missing"),
+    (
+        "t,wx,wy,wz,sigma_omega\n0,1,2,3,0\n",
+        {},
+        r"line 2, column 'sigma_omega': sigma is 0\.0; a sigma must be positive and finite where its observation",
+    ),
+    (
+        "t,wx,wy,wz\n0,1,2,3\n1,1,,3\n",
+        {},
+        r"line 3: the angular velocity is partly missing \(column 'wy' empty/NaN, the rest given in columns wx, wy, wz\)",
+    ),
+    (
+        "t,wx,wy,wz,sigma_wx,sigma_wy,sigma_wz\n0,,,,1,,1\n1,1,2,3,1,,1\n",
+        {},
+        r"line 3, column 'sigma_wy': sigma is missing",
+    ),
     (Q + "0,1,0,0,0,\n", {}, r"line 2: 6 cells, but the header \(line 1\) has 5 columns"),
     ("t,qw,qx,qy,qz,sigma_attitude_deg\n0,1,0,0,0,inf\n", {}, r"column 'sigma_attitude_deg': sigma is inf deg"),
-    ("t,wx,wy,wz,sigma_axis_deg\n0,1,2,3,1\n", {},
-     r"column sigma_axis_deg without ax, ay, az: a sigma needs its observation"),
-    ("t,wx,wy,wz,sigma_omega,sigma_wx,sigma_wy,sigma_wz\n0,1,2,3,1,1,1,1\n", {},
-     r"both sigma_omega and sigma_wx, sigma_wy, sigma_wz"),
+    (
+        "t,wx,wy,wz,sigma_axis_deg\n0,1,2,3,1\n",
+        {},
+        r"column sigma_axis_deg without ax, ay, az: a sigma needs its observation",
+    ),
+    (
+        "t,wx,wy,wz,sigma_omega,sigma_wx,sigma_wy,sigma_wz\n0,1,2,3,1,1,1,1\n",
+        {},
+        r"both sigma_omega and sigma_wx, sigma_wy, sigma_wz",
+    ),
     ("t,wx,wy,wz\n0,1,2,3\n", {"sigma_attitude_deg": 1.0}, r"sigma_attitude_deg=1\.0 is given, but .* has no attitude"),
     ("t,wx,wy,wz\n0,1,2,3\n", {"sigma_omega": -1}, r"sigma_omega must be positive and finite, got -1"),
     ("t,wx,wy,wz\n0,1,2,3\n", {"sigma_omega": "0.1"}, r"sigma_omega must be a positive number, got str '0\.1'"),
@@ -247,8 +317,11 @@ def test_file_errors(tmp_path):
     with pytest.raises(InvalidInputError, match=r"dir\.csv: not a file"):
         read_observations(tmp_path / "dir.csv")
     (tmp_path / "obs.txt").write_text("t,wx,wy,wz\n0,1,2,3\n")
-    with pytest.raises(InvalidInputError, match=r"obs\.txt: unknown observations file extension '\.txt'; "
-                                                 r"expected \.csv, \.nc or \.toml"):
+    with pytest.raises(
+        InvalidInputError,
+        match=r"obs\.txt: unknown observations file extension '\.txt'; "
+        r"expected \.csv, \.nc or \.toml",
+    ):
         read_observations(tmp_path / "obs.txt")
     with pytest.raises(InvalidInputError, match=r"path must be a file name .* got int 3"):
         read_observations(3)
@@ -341,20 +414,34 @@ def _nc_error(tmp_path, ds, match, **kwargs):
 
 def test_netcdf_errors(tmp_path, rng, xr):
     ds, *_ = _dataset(xr, rng)
-    _nc_error(tmp_path, ds, r"omega_frame='body' contradicts .*bad\.nc, where omega has frame = 'space'",
-              omega_frame="body")
-    _nc_error(tmp_path, ds, r"axis=\[1\.0, 0\.0, 0\.0\] contradicts .*where axis_direction has axis = \[0\.0, 1\.0",
-              axis=[1, 0, 0])
-    _nc_error(tmp_path, ds.assign(sigma_omega=("t", np.zeros(6))),
-              r"unknown variable 'sigma_omega' \(a misspelt name\?\); known variables: t \(coordinate\), q, attitude")
+    _nc_error(
+        tmp_path, ds, r"omega_frame='body' contradicts .*bad\.nc, where omega has frame = 'space'", omega_frame="body"
+    )
+    _nc_error(
+        tmp_path,
+        ds,
+        r"axis=\[1\.0, 0\.0, 0\.0\] contradicts .*where axis_direction has axis = \[0\.0, 1\.0",
+        axis=[1, 0, 0],
+    )
+    _nc_error(
+        tmp_path,
+        ds.assign(sigma_omega=("t", np.zeros(6))),
+        r"unknown variable 'sigma_omega' \(a misspelt name\?\); known variables: t \(coordinate\), q, attitude",
+    )
     _nc_error(tmp_path, ds.drop_vars("omega").assign(Omega=ds["omega"]), r"unknown variable 'Omega'")
-    _nc_error(tmp_path, ds.assign(attitude=(("t", "quaternion"), ds["q"].values)),
-              r"both variables 'q' and 'attitude'; give one of them")
+    _nc_error(
+        tmp_path,
+        ds.assign(attitude=(("t", "quaternion"), ds["q"].values)),
+        r"both variables 'q' and 'attitude'; give one of them",
+    )
     bad = ds.copy()
     bad["q"] = bad["q"] * 2
     _nc_error(tmp_path, bad, r"bad\.nc, t index 0: the quaternion .* has norm 2, not 1")
-    _nc_error(tmp_path, ds.drop_vars("q").assign(q=(("quaternion", "t"), ds["q"].values.T)),
-              r"variable 'q' must have dimensions \(t, 4\), got \('quaternion', 't'\)")
+    _nc_error(
+        tmp_path,
+        ds.drop_vars("q").assign(q=(("quaternion", "t"), ds["q"].values.T)),
+        r"variable 'q' must have dimensions \(t, 4\), got \('quaternion', 't'\)",
+    )
     bad = ds.copy()
     bad["omega"].attrs["frame"] = "world"
     _nc_error(tmp_path, bad, r"attribute 'frame' of variable 'omega' must be 'body' or 'space', got 'world'")
@@ -367,12 +454,18 @@ def test_netcdf_errors(tmp_path, rng, xr):
     bad = ds.copy()
     del bad["axis_direction"].attrs["axis"]
     _nc_error(tmp_path, bad, r"variable 'axis_direction' give the space direction of a body axis, but not which")
-    _nc_error(tmp_path, ds.drop_vars(["q", "omega", "axis_direction", "attitude_sigma", "omega_sigma", "axis_sigma"]),
-              r"no observation variables; give at least one of q \(or attitude\), omega, axis_direction")
+    _nc_error(
+        tmp_path,
+        ds.drop_vars(["q", "omega", "axis_direction", "attitude_sigma", "omega_sigma", "axis_sigma"]),
+        r"no observation variables; give at least one of q \(or attitude\), omega, axis_direction",
+    )
     _nc_error(tmp_path, ds.drop_vars(["q"]), r"variable 'attitude_sigma' without its observation")
     _nc_error(tmp_path, ds.assign_coords(t=ds.t.values[::-1].copy()), r"t index 1: time t = 4\.0 is before t = 5\.0")
-    _nc_error(tmp_path, xr.Dataset({"omega": (("time", "xyz"), np.zeros((2, 3)))}),
-              r"no dimension 't' \(the times of the observations\); dimensions: time, xyz")
+    _nc_error(
+        tmp_path,
+        xr.Dataset({"omega": (("time", "xyz"), np.zeros((2, 3)))}),
+        r"no dimension 't' \(the times of the observations\); dimensions: time, xyz",
+    )
     (tmp_path / "junk.nc").write_bytes(b"this is not a netcdf file")
     with pytest.raises(InvalidInputError, match=r"junk\.nc: not a readable NetCDF file"):
         read_observations(tmp_path / "junk.nc")
@@ -416,35 +509,50 @@ def test_toml_netcdf_principal_axes_conflict(tmp_path, rng, xr):
     (tmp_path / "ok.toml").write_text('[observations]\nfile = "obs.nc"\nprincipal_axes = "fit"\n')
     assert read_observations(tmp_path / "ok.toml").principal_axes == "fit"
     (tmp_path / "obs.toml").write_text('[observations]\nfile = "obs.nc"\nprincipal_axes = "given"\n')
-    with pytest.raises(InvalidInputError, match=r"obs\.toml: \[observations\] principal_axes = 'given' contradicts "
-                                                 r".*obs\.nc, whose attribute principal_axes = 'fit'"):
+    with pytest.raises(
+        InvalidInputError,
+        match=r"obs\.toml: \[observations\] principal_axes = 'given' contradicts "
+        r".*obs\.nc, whose attribute principal_axes = 'fit'",
+    ):
         read_observations(tmp_path / "obs.toml")
 
 
 TOML_ERRORS = [
     ('[observations\nfile = "obs.csv"\n', r"cfg\.toml: invalid TOML"),
     ('[obs]\nfile = "obs.csv"\n', r"cfg\.toml: no \[observations\] table"),
-    ('observations = 3\n', r"'observations' must be a table"),
-    ('[observations]\nfile = "obs.csv"\nsigma_att = 1\n',
-     r"cfg\.toml: unknown key 'sigma_att' in \[observations\]; allowed keys: file, sigma_attitude_deg, sigma_omega, "
-     r"sigma_axis_deg, omega_frame, axis, principal_axes"),
+    ("observations = 3\n", r"'observations' must be a table"),
+    (
+        '[observations]\nfile = "obs.csv"\nsigma_att = 1\n',
+        r"cfg\.toml: unknown key 'sigma_att' in \[observations\]; allowed keys: file, sigma_attitude_deg, sigma_omega, "
+        r"sigma_axis_deg, omega_frame, axis, principal_axes",
+    ),
     ("[observations]\nsigma_omega = 1\n", r"\[observations\] file is required"),
     ("[observations]\nfile = 3\n", r"\[observations\] file must be a file name"),
     ('[observations]\nfile = "obs.dat"\n', r"file = 'obs\.dat' must be a \.csv or \.nc file"),
     ('[observations]\nfile = "other.csv"\n', r"other\.csv \(the file of .*cfg\.toml\): no such file"),
-    ('[observations]\nfile = "obs.csv"\nsigma_omega = "big"\n',
-     r"cfg\.toml: \[observations\] sigma_omega must be a positive number, got str 'big'"),
+    (
+        '[observations]\nfile = "obs.csv"\nsigma_omega = "big"\n',
+        r"cfg\.toml: \[observations\] sigma_omega must be a positive number, got str 'big'",
+    ),
     ('[observations]\nfile = "obs.csv"\nsigma_omega = 0\n', r"\[observations\] sigma_omega must be positive"),
-    ('[observations]\nfile = "obs.csv"\nomega_frame = "Body"\n',
-     r"\[observations\] omega_frame must be 'body' or 'space', got 'Body'"),
+    (
+        '[observations]\nfile = "obs.csv"\nomega_frame = "Body"\n',
+        r"\[observations\] omega_frame must be 'body' or 'space', got 'Body'",
+    ),
     ('[observations]\nfile = "obs.csv"\naxis = [0, 1]\n', r"\[observations\] axis must be three numbers"),
     ('[observations]\nfile = "obs.csv"\naxis = "z"\n', r"\[observations\] axis must be three numbers .* string 'z'"),
-    ('[observations]\nfile = "obs.csv"\nprincipal_axes = "yes"\n',
-     r"\[observations\] principal_axes must be 'given' or 'fit', got 'yes'"),
-    ('[observations]\nfile = "obs.csv"\nsigma_axis_deg = 1\n',
-     r"cfg\.toml: \[observations\] sigma_axis_deg = 1\.0 is given, but .*obs\.csv has no axis direction"),
-    ('[observations]\nfile = "obs.csv"\naxis = [0, 0, 1]\n',
-     r"cfg\.toml: \[observations\] axis = \[0\.0, 0\.0, 1\.0\] is given, but .*obs\.csv has no axis direction"),
+    (
+        '[observations]\nfile = "obs.csv"\nprincipal_axes = "yes"\n',
+        r"\[observations\] principal_axes must be 'given' or 'fit', got 'yes'",
+    ),
+    (
+        '[observations]\nfile = "obs.csv"\nsigma_axis_deg = 1\n',
+        r"cfg\.toml: \[observations\] sigma_axis_deg = 1\.0 is given, but .*obs\.csv has no axis direction",
+    ),
+    (
+        '[observations]\nfile = "obs.csv"\naxis = [0, 0, 1]\n',
+        r"cfg\.toml: \[observations\] axis = \[0\.0, 0\.0, 1\.0\] is given, but .*obs\.csv has no axis direction",
+    ),
 ]
 
 

@@ -97,8 +97,9 @@ def test_scalar_last_file_read_as_scalar_first_is_named(capsys, tmp_path, racket
     code, out, err = run(capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-6")
     assert code == 1
     assert re.search(r"the quaternions look scalar-last \(x, y, z, w\): rerun with --quaternion-order xyzw", out)
-    code, out, err = run(capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-9",
-                         "--quaternion-order", "xyzw")
+    code, out, err = run(
+        capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-9", "--quaternion-order", "xyzw"
+    )
     assert code == 0 and "PASS" in out
     # the column names may say the order themselves
     good = write_csv(tmp_path / "named.csv", t, np.roll(q, -1, axis=1), w, header="t,qx,qy,qz,qw,wx,wy,wz")
@@ -124,8 +125,9 @@ def test_space_to_body_attitudes_are_named(capsys, tmp_path, racket):
     bad = write_csv(tmp_path / "conj.csv", t, q * [1, -1, -1, -1], w)
     code, out, err = run(capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-6")
     assert code == 1 and "rerun with --attitude-convention space-to-body" in out
-    code, out, err = run(capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-9",
-                         "--attitude-convention", "space-to-body")
+    code, out, err = run(
+        capsys, "validate", bad, "--inertia", "3,5,8", "--tolerance", "1e-9", "--attitude-convention", "space-to-body"
+    )
     assert code == 0
 
 
@@ -141,8 +143,11 @@ def test_wrong_inertia_is_only_a_warning(capsys, tmp_path, racket):
     f = write_csv(tmp_path / "r.csv", t, q, w)
     code, out, err = run(capsys, "validate", f, "--inertia", "1,2,2.5")
     assert code == 0
-    assert re.search(r"warning: the run's energy and angular momentum are conserved as those of an inertia close to "
-                     r"\[1\.03\d*, 1\.71\d*, 2\.75\].*check --inertia", err)
+    assert re.search(
+        r"warning: the run's energy and angular momentum are conserved as those of an inertia close to "
+        r"\[1\.03\d*, 1\.71\d*, 2\.75\].*check --inertia",
+        err,
+    )
 
 
 # --------------------------------------------------------------------------- input formats, report, plot
@@ -152,8 +157,9 @@ def test_json_records_and_netcdf_and_plot(capsys, tmp_path, racket):
     (tmp_path / "r.json").write_text(json.dumps(recs))
     code, out, err = run(capsys, "validate", tmp_path / "r.json", "--inertia", "3,5,8", "--json")
     assert code == 0 and json.loads(out)["verdict"] == "round-off"
-    (tmp_path / "r2.json").write_text(json.dumps([{"t": a, "quaternion": b.tolist(), "omega": c.tolist()}
-                                                  for a, b, c in zip(t, q, w)]))
+    (tmp_path / "r2.json").write_text(
+        json.dumps([{"t": a, "quaternion": b.tolist(), "omega": c.tolist()} for a, b, c in zip(t, q, w)])
+    )
     code, out, err = run(capsys, "validate", tmp_path / "r2.json", "--inertia", "3,5,8", "--plot", tmp_path / "e.png")
     assert code == 0 and "ROUND-OFF" in out and "flips (exact)" in out
     assert (tmp_path / "e.png").stat().st_size > 10_000
@@ -165,8 +171,18 @@ def test_report_keys_and_perturbed_run(racket):
     q2[300:] = ep.attitude.quaternion_multiply(q[300:], [np.cos(5e-4), np.sin(5e-4), 0.0, 0.0])  # 1e-3 rad
     rep = validate(run_from_arrays(t, q2, w), [3, 5, 8], tolerance=1e-4)
     d = rep.to_dict()
-    for key in ("max_attitude_error", "max_omega_error", "energy_drift", "momentum_drift", "flip_times",
-                "flip_time_errors", "exceeded_at", "verdict", "convention_hint", "warnings"):
+    for key in (
+        "max_attitude_error",
+        "max_omega_error",
+        "energy_drift",
+        "momentum_drift",
+        "flip_times",
+        "flip_time_errors",
+        "exceeded_at",
+        "verdict",
+        "convention_hint",
+        "warnings",
+    ):
         assert key in d
     assert d["max_attitude_error"] == pytest.approx(1e-3, rel=1e-9)
     assert d["exceeded_at"] == t[300] and d["verdict"] == "fail" and not rep.passed
@@ -178,8 +194,10 @@ def test_report_keys_and_perturbed_run(racket):
     [
         ("t,qw,qx,qy,wx,wy,wz\n0,1,0,0,0,0,0\n1,1,0,0,0,0,0\n", r"missing column\(s\) qz"),
         ("t,qw,qx,qy,qz,wx,wy\n0,1,0,0,0,0,0\n", r"missing column\(s\) wz"),
-        (HEADER + "\n0,1,0,0,0,0,0.1,0\n2,1,0,0,0,0,0.1,0\n1,1,0,0,0,0,0.1,0\n",
-         r"times must increase strictly; sample 2 has t = 1.0 after t = 2.0"),
+        (
+            HEADER + "\n0,1,0,0,0,0,0.1,0\n2,1,0,0,0,0,0.1,0\n1,1,0,0,0,0,0.1,0\n",
+            r"times must increase strictly; sample 2 has t = 1.0 after t = 2.0",
+        ),
         (HEADER + "\n0,1,0,0,0,0,0.1,0\n1,1.1,0,0,0,0,0.1,0\n", r"sample 1 \(t = 1\) has norm 1.1, far from 1"),
         (HEADER + "\n0,1,0,0,0,0,0.1,0\n1,1,0,x,0,0,0.1,0\n", r"row 3, column qy: 'x' is not a number"),
         (HEADER + "\n0,1,0,0,0,0,0.1,0\n", r"at least 2 samples"),
@@ -242,15 +260,21 @@ def test_assert_free_motion_passes_and_fails_with_the_first_time(racket):
     assert_free_motion(t, q, ws, [3, 5, 8], atol=1e-12, omega_frame="space", omega_rtol=1e-12)
     q2 = q.copy()
     q2[200:] = ep.attitude.quaternion_multiply(q[200:], [np.cos(1e-3), 0.0, np.sin(1e-3), 0.0])
-    with pytest.raises(AssertionError, match=rf"attitude error is 0.002 rad > atol = 0.0001 first at t = {t[200]:.9g} "
-                                             r"\(sample 200\)"):
+    with pytest.raises(
+        AssertionError,
+        match=rf"attitude error is 0.002 rad > atol = 0.0001 first at t = {t[200]:.9g} "
+        r"\(sample 200\)",
+    ):
         assert_free_motion(t, q2, w, [3, 5, 8], atol=1e-4)
     with pytest.raises(AssertionError, match=r"rerun with --omega-frame space"):
         assert_free_motion(t, q, ws, [3, 5, 8], atol=1e-4)
     w2 = w.copy()
     w2[100:] *= [1.0, 1.01, 1.0]
-    with pytest.raises(AssertionError, match=r"relative angular velocity error is 0.0\d+ > omega_rtol = 0.001 first at "
-                                             rf"t = {t[100]:.9g} \(sample 100\)"):
+    with pytest.raises(
+        AssertionError,
+        match=r"relative angular velocity error is 0.0\d+ > omega_rtol = 0.001 first at "
+        rf"t = {t[100]:.9g} \(sample 100\)",
+    ):
         assert_free_motion(t, q, w2, [3, 5, 8], atol=10.0, omega_rtol=1e-3)
 
 

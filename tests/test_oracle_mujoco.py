@@ -13,8 +13,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-mujoco = pytest.importorskip("mujoco", exc_type=ImportError, reason="the optional test dependency mujoco is not installed "
-                                               "(pip install mujoco, or `make test` installs it where it can)")
+mujoco = pytest.importorskip(
+    "mujoco",
+    exc_type=ImportError,
+    reason="the optional test dependency mujoco is not installed "
+    "(pip install mujoco, or `make test` installs it where it can)",
+)
 
 from _reference import quaternion_distance  # noqa: E402
 from _torque_reference import reference_motion  # noqa: E402
@@ -29,8 +33,7 @@ _spec.loader.exec_module(vm)
 def _qmul(p, q):
     pw, pv = p[..., :1], p[..., 1:]
     qw, qv = q[..., :1], q[..., 1:]
-    return np.concatenate([pw * qw - np.sum(pv * qv, -1, keepdims=True),
-                           pw * qv + qw * pv + np.cross(pv, qv)], -1)
+    return np.concatenate([pw * qw - np.sum(pv * qv, -1, keepdims=True), pw * qv + qw * pv + np.cross(pv, qv)], -1)
 
 
 @pytest.fixture(scope="module")
@@ -80,8 +83,9 @@ def test_reported_error_is_the_true_error(capsys, runs, integ):
     assert code == 0, err
     # an independent integration (30-digit Taylor series in mpmath, no eulerpoisson code) from the CSV's first sample
     data = np.loadtxt(path, delimiter=",", skiprows=1)
-    q_ref, w_ref = reference_motion(vm.INERTIA, data[0, 1:5] / np.linalg.norm(data[0, 1:5]), data[0, 5:8], data[:, 0],
-                                    dps=30)
+    q_ref, w_ref = reference_motion(
+        vm.INERTIA, data[0, 1:5] / np.linalg.norm(data[0, 1:5]), data[0, 5:8], data[:, 0], dps=30
+    )
     true = quaternion_distance(q_ref, data[:, 1:5] / np.linalg.norm(data[:, 1:5], axis=1, keepdims=True))
     assert rep["max_attitude_error"] == pytest.approx(true.max(), rel=1e-6, abs=1e-13)
     true_w = np.max(np.linalg.norm(data[:, 5:8] - w_ref, axis=1)) / np.max(np.linalg.norm(w_ref, axis=1))
@@ -115,7 +119,9 @@ def test_mujoco_space_frame_rates_are_detected(capsys, runs, tmp_path):
     from eulerpoisson.attitude.core import matrix_from_unit_quaternion
 
     bad = tmp_path / "space.csv"
-    vm.write_csv(bad, t, q, np.einsum("tij,tj->ti", matrix_from_unit_quaternion(q / np.linalg.norm(q, axis=1)[:, None]), w))
+    vm.write_csv(
+        bad, t, q, np.einsum("tij,tj->ti", matrix_from_unit_quaternion(q / np.linalg.norm(q, axis=1)[:, None]), w)
+    )
     code, rep, err = _validate(capsys, bad, "--tolerance", "1e-6")
     assert code == 1 and "--omega-frame space" in rep["convention_hint"]
     code, rep, err = _validate(capsys, bad, "--tolerance", "1e-6", "--omega-frame", "space")

@@ -132,7 +132,7 @@ def test_envelope_any_order_and_nan():
     col = np.clip(np.floor(t).astype(int), 0, 9)
     for c in range(10):
         sel = y[col == c]
-        assert np.nanmin(sel) == np.nanmin(yy[2 * c:2 * c + 2]) and np.nanmax(sel) == np.nanmax(yy[2 * c:2 * c + 2])
+        assert np.nanmin(sel) == np.nanmin(yy[2 * c : 2 * c + 2]) and np.nanmax(sel) == np.nanmax(yy[2 * c : 2 * c + 2])
     dec = MinMaxEnvelope(0.0, 10.0, 1, nbins=10)  # decreasing times: the monotonic path, reversed
     order = np.argsort(-t)
     dec.add(t[order], y[order])

@@ -277,8 +277,9 @@ def test_plot_gibbs_marks_restarts(racket):
 MAGIC = {"png": b"\x89PNG\r\n\x1a\n", "pdf": b"%PDF", "svg": b"<?xml"}
 
 
-@pytest.mark.parametrize("kind,fmt", [("omega", "svg"), ("invariants", "pdf"), ("polhode", "png"),
-                                      ("gibbs", "png"), ("attitude", "png")])
+@pytest.mark.parametrize(
+    "kind,fmt", [("omega", "svg"), ("invariants", "pdf"), ("polhode", "png"), ("gibbs", "png"), ("attitude", "png")]
+)
 def test_plot_writes_files_atomically(racket, tmp_path, kind, fmt):
     out = tmp_path / "sub" / f"{kind}.{fmt}"
     fig = plots.plot(racket, kind, out=out, dpi=40)

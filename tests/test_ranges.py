@@ -44,13 +44,23 @@ def test_exact_range_limit_is_where_documented():
 @pytest.mark.parametrize(
     "method, kw, match",
     [
-        ("symplectic", dict(t=[0.0, 1.0], dt=1e-300),
-         r"symplectic: reaching \|t\| = 1 needs about 1e\+300 steps, more than max_steps"),
+        (
+            "symplectic",
+            dict(t=[0.0, 1.0], dt=1e-300),
+            r"symplectic: reaching \|t\| = 1 needs about 1e\+300 steps, more than max_steps",
+        ),
         ("symplectic", dict(t=[0.0, 1e300]), r"symplectic: reaching \|t\| = 1e\+300 needs"),
         ("symplectic", dict(t=[0.0, 1.0], omega0=[1e300, 0.0, 0.0]), r"symplectic: .* needs about inf steps"),
-        ("symplectic", dict(t=[-3.0, 4.0], dt=0.5, max_steps=13),
-         r"reaching \|t\| = 7 needs about 14 steps, more than max_steps=13"),
-        ("rk", dict(t=[0.0, 1e300]), r"rk: reaching \|t\| = 1e\+300 needs about .* steps, more than max_steps=10000000"),
+        (
+            "symplectic",
+            dict(t=[-3.0, 4.0], dt=0.5, max_steps=13),
+            r"reaching \|t\| = 7 needs about 14 steps, more than max_steps=13",
+        ),
+        (
+            "rk",
+            dict(t=[0.0, 1e300]),
+            r"rk: reaching \|t\| = 1e\+300 needs about .* steps, more than max_steps=10000000",
+        ),
         ("rk", dict(t=[0.0, 1.0], omega0=[1e200, 1e200, 0.0]), r"rk: .* needs about inf steps"),
     ],
 )
@@ -85,7 +95,9 @@ def test_rk_step_budget_during_the_run():
 
 def test_rk_gibbs_without_chart_changes_fails_with_a_hint():
     # a threshold of 1e300 squares to inf (no OverflowError): |n| then blows up at the half turn
-    with pytest.raises(EulerPoissonError, match=r"rk: solve_ivp .* failed: .*formulation='gibbs'.*chart_threshold=1e\+300"):
+    with pytest.raises(
+        EulerPoissonError, match=r"rk: solve_ivp .* failed: .*formulation='gibbs'.*chart_threshold=1e\+300"
+    ):
         solve(I123, [0.0, 10.0], omega0=W0, method="rk", formulation="gibbs", chart_threshold=1e300)
 
 
@@ -107,7 +119,9 @@ def test_boolean_flags_refuse_truthy_strings():
 
 @pytest.mark.parametrize("which", ["omega0", "m0"])
 def test_solve_names_the_shapes_that_do_not_broadcast(which):
-    with pytest.raises(InvalidInputError, match=rf"batch shapes do not broadcast: body \(\) .*{which} \(2,\) .*attitude0 \(3,\)"):
+    with pytest.raises(
+        InvalidInputError, match=rf"batch shapes do not broadcast: body \(\) .*{which} \(2,\) .*attitude0 \(3,\)"
+    ):
         solve(I123, [0.0, 1.0], **{which: [[1.0, 2.0, 3.0]] * 2}, attitude0=[[1.0, 0, 0, 0]] * 3)
     body = RigidBody(np.array([I123] * 4))
     with pytest.raises(InvalidInputError, match=r"body \(4,\) \(inertia \(4, 3, 3\)\)"):
@@ -122,7 +136,9 @@ def test_gibbs_formulations_refuse_n_beyond_1e50(name):
     f = formulation(name, I123)
     s = np.r_[1e160, 5e159, 0.0, 0.3, 1.0, 0.2]
     for call in (f.hamiltonian, f.vector_field, f.to_common, f.omega):
-        with pytest.raises(SingularChartError, match=rf"state of the '{name}' formulation: \|n\| = 1.12e\+160 exceeds 1e\+50"):
+        with pytest.raises(
+            SingularChartError, match=rf"state of the '{name}' formulation: \|n\| = 1.12e\+160 exceeds 1e\+50"
+        ):
             call(s)
     # the attitude of such a state is still available (the conversions take any finite n)
     q = f.quaternion(s)
@@ -155,7 +171,10 @@ def test_gibbs_formulations_near_the_half_turn_lose_only_what_the_chart_loses(na
         (lambda at, A: at.gibbs_rate_from_omega([[0, 0, 1.0]] * 2, [[0, 0, 1.0]] * 3), r"n \(2, 3\), omega \(3, 3\)"),
         (lambda at, A: at.omega_from_gibbs_rate([[0, 0, 1.0]] * 2, [[0, 0, 1.0]] * 3), r"n \(2, 3\), ndot \(3, 3\)"),
         (lambda at, A: at.gibbs_chart([[1.0, 0, 0, 0]] * 2, [[1.0, 0, 0, 0]] * 3), r"q \(2, 4\), reference \(3, 4\)"),
-        (lambda at, A: at.quaternion_from_chart([[1.0, 0, 0, 0]] * 2, [[0, 0, 1.0]] * 3), r"reference \(2, 4\), n \(3, 3\)"),
+        (
+            lambda at, A: at.quaternion_from_chart([[1.0, 0, 0, 0]] * 2, [[0, 0, 1.0]] * 3),
+            r"reference \(2, 4\), n \(3, 3\)",
+        ),
         (lambda at, A: A.identity(2) * A.identity(3), r"self \(2, 4\), other \(3, 4\)"),
         (lambda at, A: A.identity(2).angle_to(A.identity(3)), r"self \(2, 4\), other \(3, 4\)"),
     ],

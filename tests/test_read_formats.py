@@ -152,8 +152,25 @@ def test_cli_reads_every_format(files, tmp_path, capsys):
     """info, plot and animate on a .zarr store written by simulate (refused before) and on NetCDF-3."""
     _, _, nc3, _ = files
     store = tmp_path / "sim.zarr"
-    assert main(["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10", "--samples", "300",
-                 "--out", str(store), "--quiet"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--inertia",
+                "1,2,3",
+                "--omega",
+                "1,0.1,0.5",
+                "--t-end",
+                "10",
+                "--samples",
+                "300",
+                "--out",
+                str(store),
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     capsys.readouterr()
     for path in (store, nc3):
         assert main(["info", str(path)]) == 0, capsys.readouterr().err

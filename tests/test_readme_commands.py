@@ -48,6 +48,14 @@ def test_readme_commands_run_top_to_bottom(tmp_path):
         res = subprocess.run([EXE, *argv[1:]], cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
         assert res.returncode == 0, f"{cmd}\n{res.stderr}"
         assert "Traceback" not in res.stderr, cmd
-    for name in ("run.nc", "polhode.png", "movie.html", "atlas.zarr", "atlas.png", "top.nc", "top_apex.png",
-                 "long.zarr"):
+    for name in (
+        "run.nc",
+        "polhode.png",
+        "movie.html",
+        "atlas.zarr",
+        "atlas.png",
+        "top.nc",
+        "top_apex.png",
+        "long.zarr",
+    ):
         assert (tmp_path / name).exists(), name

@@ -112,16 +112,26 @@ def test_trajectory_batch_and_torque():
     tr = ep.solve(bodies, np.linspace(0.0, 5.0, 51), omega0=[1.0, 0.1, 0.5])
     text = "".join(well_formed(tr._repr_html_()).text)
     assert "51 × 3 bodies" in text and "first body" in "".join(tr._repr_html_()) and "kinds" in text
-    top = ep.solve([1.0, 1.0, 0.5], np.linspace(0.0, 1.0, 21), omega0=[0.0, 0.0, 20.0],
-                   attitude0=ep.Attitude.from_rotvec([0.3, 0.0, 0.0]), torque=ep.torques.Gravity(1.0, [0, 0, 0.1]), method="rk")
+    top = ep.solve(
+        [1.0, 1.0, 0.5],
+        np.linspace(0.0, 1.0, 21),
+        omega0=[0.0, 0.0, 20.0],
+        attitude0=ep.Attitude.from_rotvec([0.3, 0.0, 0.0]),
+        torque=ep.torques.Gravity(1.0, [0, 0, 0.1]),
+        method="rk",
+    )
     text = "".join(well_formed(top._repr_html_()).text)
     assert "Gravity(" in text and "m_vertical" in text
 
 
 @pytest.mark.parametrize("T", [0, 1, 2])
 def test_trajectory_short(T):
-    tr = ep.Trajectory(np.arange(T, dtype=float), np.tile([1.0, 0, 0, 0], (T, 1)), np.tile([0.0, 0, 1], (T, 1)),
-                       ep.RigidBody([1.0, 2.0, 2.5]))
+    tr = ep.Trajectory(
+        np.arange(T, dtype=float),
+        np.tile([1.0, 0, 0, 0], (T, 1)),
+        np.tile([0.0, 0, 1], (T, 1)),
+        ep.RigidBody([1.0, 2.0, 2.5]),
+    )
     p = well_formed(tr._repr_html_())
     assert p.tags.count("svg") == (2 if T == 2 else 0)
 
@@ -172,8 +182,14 @@ def test_zarr_store_is_read_lazily(tmp_path, monkeypatch):
     from eulerpoisson.io.stream import solve_to_file
 
     T, chunk = 400, 20  # 20 chunks
-    path = solve_to_file(ep.RigidBody([1.0, 2.0, 2.5], name=EVIL), (0.0, 40.0, T), tmp_path / "run.zarr",
-                         omega0=[1.0, 0.1, 0.5], chunk=chunk, progress=False)
+    path = solve_to_file(
+        ep.RigidBody([1.0, 2.0, 2.5], name=EVIL),
+        (0.0, 40.0, T),
+        tmp_path / "run.zarr",
+        omega0=[1.0, 0.1, 0.5],
+        chunk=chunk,
+        progress=False,
+    )
     lz = ep.Trajectory.open(path)
     assert isinstance(lz, rd.LazyTrajectory)
 

@@ -39,8 +39,9 @@ def test_agrees_with_reference(formulation, reference):
 def test_every_scipy_integrator_works(integrator, reference):
     q_ref, w_ref = reference
     for formulation in ("quaternion", "gibbs"):
-        tr = solve(BODY, T, omega0=W0, attitude0=Q0, method="rk", integrator=integrator,
-                   formulation=formulation, tol=1e-8)
+        tr = solve(
+            BODY, T, omega0=W0, attitude0=Q0, method="rk", integrator=integrator, formulation=formulation, tol=1e-8
+        )
         assert tr.stats["integrator"] == integrator and tr.stats["nfev"] > 0
         err = max(np.max(quaternion_distance(tr.quaternion, q_ref)), np.max(np.abs(tr.omega - w_ref)))
         assert err < 1e-4, (integrator, formulation, err)
@@ -69,8 +70,7 @@ def test_formulations_agree_through_many_chart_changes():
 @pytest.mark.parametrize("threshold", [0.3, 5.0])
 def test_chart_threshold(threshold, reference):
     q_ref, _ = reference
-    tr = solve(BODY, T, omega0=W0, attitude0=Q0, method="rk", formulation="gibbs", tol=1e-11,
-               chart_threshold=threshold)
+    tr = solve(BODY, T, omega0=W0, attitude0=Q0, method="rk", formulation="gibbs", tol=1e-11, chart_threshold=threshold)
     assert np.max(quaternion_distance(tr.quaternion, q_ref)) < 1e-8
 
 
@@ -87,17 +87,20 @@ def test_nominal_order():
     assert RK(integrator="RK23").nominal_order() == 3
 
 
-@pytest.mark.parametrize("opts,match", [
-    ({"integrator": "Euler"}, "unknown integrator 'Euler'"),
-    ({"integrator": "dop853"}, "unknown integrator"),
-    ({"formulation": "euler-angles"}, "unknown formulation"),
-    ({"tol": 0.0}, "tol must be"),
-    ({"tol": float("inf")}, "tol must be"),
-    ({"rtol": -1e-3}, "rtol must be"),
-    ({"atol": "small"}, "atol must be"),
-    ({"chart_threshold": 0.0}, "chart_threshold must be > 0"),
-    ({"chart_threshold": -2.0}, "chart_threshold"),
-])
+@pytest.mark.parametrize(
+    "opts,match",
+    [
+        ({"integrator": "Euler"}, "unknown integrator 'Euler'"),
+        ({"integrator": "dop853"}, "unknown integrator"),
+        ({"formulation": "euler-angles"}, "unknown formulation"),
+        ({"tol": 0.0}, "tol must be"),
+        ({"tol": float("inf")}, "tol must be"),
+        ({"rtol": -1e-3}, "rtol must be"),
+        ({"atol": "small"}, "atol must be"),
+        ({"chart_threshold": 0.0}, "chart_threshold must be > 0"),
+        ({"chart_threshold": -2.0}, "chart_threshold"),
+    ],
+)
 def test_bad_options(opts, match):
     with pytest.raises(InvalidInputError, match=match):
         solve(BODY, [0.0, 1.0], omega0=W0, method="rk", **opts)

@@ -27,8 +27,15 @@ TIME_VARS = ("quaternion", "omega", "M", "m", "energy", "gibbs")
 def _qmul(p, q):
     pw, px, py, pz = np.moveaxis(p, -1, 0)
     qw, qx, qy, qz = np.moveaxis(q, -1, 0)
-    return np.stack([pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw], -1)
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        -1,
+    )
 
 
 @dataclasses.dataclass(frozen=True)
@@ -96,14 +103,24 @@ def _open(path):
 # ---------------------------------------------------------------------------
 # the lazy time grid
 # ---------------------------------------------------------------------------
-@pytest.mark.parametrize("t0, t1, n", [(0.0, 7.0, 1001), (-3.0, 11.5, 17), (5.0, -2.0, 400), (1.5, 1.5, 4),
-                                       (0.0, 1e-310, 3), (2.0, 9.0, 1), (0.1, 0.7, 2)])
+@pytest.mark.parametrize(
+    "t0, t1, n",
+    [
+        (0.0, 7.0, 1001),
+        (-3.0, 11.5, 17),
+        (5.0, -2.0, 400),
+        (1.5, 1.5, 4),
+        (0.0, 1e-310, 3),
+        (2.0, 9.0, 1),
+        (0.1, 0.7, 2),
+    ],
+)
 def test_timegrid_is_linspace_bit_for_bit(t0, t1, n):
     g = TimeGrid(t0, t1, n)
     ref = np.linspace(t0, t1, n)
     assert len(g) == n and g.shape == (n,)
     np.testing.assert_array_equal(g[:], ref)
-    np.testing.assert_array_equal(g[n // 3: n - 1], ref[n // 3: n - 1])
+    np.testing.assert_array_equal(g[n // 3 : n - 1], ref[n // 3 : n - 1])
     np.testing.assert_array_equal(g[np.array([0, n - 1, -1])], ref[[0, n - 1, -1]])
     assert g[n - 1] == ref[-1] and g[0] == ref[0]
 
@@ -227,8 +244,7 @@ def test_stepping_method_needs_monotonic_times(tmp_path, rk4):
     with pytest.raises(InvalidInputError, match="strictly monotonic"):
         solve_to_file(I123, t, tmp_path / "x.zarr", omega0=W0, method=rk4, chunk=10, progress=False)
     with pytest.raises(InvalidInputError, match="strictly monotonic"):
-        solve_to_file(I123, [0.0, 1.0, 1.0, 2.0], tmp_path / "y.zarr", omega0=W0, method=rk4, chunk=10,
-                      progress=False)
+        solve_to_file(I123, [0.0, 1.0, 1.0, 2.0], tmp_path / "y.zarr", omega0=W0, method=rk4, chunk=10, progress=False)
 
 
 # ---------------------------------------------------------------------------
@@ -264,17 +280,27 @@ def test_interrupt_keeps_chunks_and_resume_finishes(tmp_path, rk4, method):
     part = _open(partial_store(path))
     ref = _open(ref_path)
     np.testing.assert_array_equal(part["omega"].values[: 3 * chunk], ref["omega"].values[: 3 * chunk])
-    assert np.all(np.isnan(part["omega"].values[3 * chunk:]))
+    assert np.all(np.isnan(part["omega"].values[3 * chunk :]))
     # a plain rerun refuses to throw the work away
     with pytest.raises(EulerPoissonError, match="resume=True"):
         solve_to_file(I123, grid, path, omega0=W0, method=meth, chunk=chunk, progress=False, **opts)
     # a rerun with other arguments cannot resume it
     with pytest.raises(InvalidInputError, match="different arguments"):
-        solve_to_file(I123, grid, path, omega0=[0.3, 1.0, 0.25], method=meth, chunk=chunk, progress=False,
-                      resume=True, **opts)
+        solve_to_file(
+            I123, grid, path, omega0=[0.3, 1.0, 0.25], method=meth, chunk=chunk, progress=False, resume=True, **opts
+        )
     calls = []
-    solve_to_file(I123, grid, path, omega0=W0, method=meth, chunk=chunk, resume=True,
-                  progress=lambda d, tot: calls.append(d), **opts)
+    solve_to_file(
+        I123,
+        grid,
+        path,
+        omega0=W0,
+        method=meth,
+        chunk=chunk,
+        resume=True,
+        progress=lambda d, tot: calls.append(d),
+        **opts,
+    )
     assert calls == list(range(3 * chunk, 1000 + 1, chunk))  # only the 7 missing chunks were computed
     assert not (tmp_path / ".run.zarr.partial").exists()
     out = _open(path)

@@ -28,8 +28,10 @@ def config(tmp_path, **changes):
     cfg = {
         "sweep": {"kind": "grid"},
         "inertia": {"I1": 1.0, "I2": [1.6, 2.0, 2.4], "I3": 3.0},
-        "momentum": {"polar": {"start": 10.0, "stop": 170.0, "num": 5},
-                     "azimuth": {"start": 0.0, "stop": 360.0, "num": 7}},
+        "momentum": {
+            "polar": {"start": 10.0, "stop": 170.0, "num": 5},
+            "azimuth": {"start": 0.0, "stop": 360.0, "num": 7},
+        },
         "output": {"path": str(tmp_path / "atlas.zarr"), "chunk": 16},
         "compute": {"T": 20.0, "delta": 1e-6, "scheduler": "serial"},
     }
@@ -117,7 +119,7 @@ def test_config_file_errors(tmp_path):
     with pytest.raises(InvalidInputError, match="invalid TOML"):
         load_config(bad)
     extra = tmp_path / "extra.toml"
-    extra.write_text('[plot]\nx = 1\n')
+    extra.write_text("[plot]\nx = 1\n")
     with pytest.raises(InvalidInputError, match=r"unknown section \[plot\]"):
         load_config(extra)
     nosec = tmp_path / "nosec.toml"
@@ -127,9 +129,18 @@ def test_config_file_errors(tmp_path):
 
 
 def test_ratios_and_log_ranges(tmp_path):
-    cfg = load_config(config(tmp_path, inertia__I2=None, inertia__I3=None, inertia__I1=2.0,
-                             inertia__ratio21={"start": 1.2, "stop": 1.8, "num": 4, "log": True},
-                             inertia__ratio31=1.9, momentum__polar=90.0, momentum__azimuth=[30.0, 60.0]))
+    cfg = load_config(
+        config(
+            tmp_path,
+            inertia__I2=None,
+            inertia__I3=None,
+            inertia__I1=2.0,
+            inertia__ratio21={"start": 1.2, "stop": 1.8, "num": 4, "log": True},
+            inertia__ratio31=1.9,
+            momentum__polar=90.0,
+            momentum__azimuth=[30.0, 60.0],
+        )
+    )
     assert cfg.axis_names == ["I1", "ratio21", "ratio31", "polar", "azimuth"]
     np.testing.assert_allclose(cfg.grid_axes["ratio21"], np.geomspace(1.2, 1.8, 4))
     ds = load_sweep(run_sweep(cfg, progress=False))
@@ -166,9 +177,14 @@ def test_half_period_and_sensitivity_against_integration():
         u = M[i] / np.linalg.norm(M[i])
         e_th = np.array([np.cos(th[i]) * np.cos(ph[i]), np.cos(th[i]) * np.sin(ph[i]), -np.sin(th[i])])
         e_ph = np.array([-np.sin(ph[i]), np.cos(ph[i]), 0.0])
-        q = [reference_motion(I[i], m / I[i], np.array([1.0, 0, 0, 0]), [T])[0][0]
-             for m in (M[i], 1.3 * (np.cos(delta) * u + np.sin(delta) * e_th),
-                       1.3 * (np.cos(delta) * u + np.sin(delta) * e_ph))]
+        q = [
+            reference_motion(I[i], m / I[i], np.array([1.0, 0, 0, 0]), [T])[0][0]
+            for m in (
+                M[i],
+                1.3 * (np.cos(delta) * u + np.sin(delta) * e_th),
+                1.3 * (np.cos(delta) * u + np.sin(delta) * e_ph),
+            )
+        ]
         ref_s = max(quaternion_distance(q[0], q[1]), quaternion_distance(q[0], q[2])) / delta
         assert abs(res["sensitivity"][i] - ref_s) < 1e-6 * ref_s
 
@@ -234,9 +250,13 @@ def test_grid_atlas_structure(reference):
 
 
 def test_atlas_peaks_at_the_separatrix(tmp_path):
-    cfg = config(tmp_path, inertia__I2=2.0, output__chunk=64,
-                 momentum__polar={"start": 0.0, "stop": 180.0, "num": 13},
-                 momentum__azimuth={"start": 0.0, "stop": 345.0, "num": 24})
+    cfg = config(
+        tmp_path,
+        inertia__I2=2.0,
+        output__chunk=64,
+        momentum__polar={"start": 0.0, "stop": 180.0, "num": 13},
+        momentum__azimuth={"start": 0.0, "stop": 345.0, "num": 24},
+    )
     ds = load_sweep(run_sweep(cfg, progress=False))
     hp = ds["half_period"]
     i, j = np.unravel_index(int(np.nanargmax(hp.values)), hp.shape)
@@ -251,8 +271,12 @@ def test_atlas_peaks_at_the_separatrix(tmp_path):
 # ---------------------------------------------------------------------------
 def test_local_cluster_equals_serial_exactly(tmp_path, cluster, reference):
     calls = []
-    path = run_sweep(config(tmp_path), path=tmp_path / "dask.zarr", scheduler=cluster.scheduler_address,
-                     progress=lambda d, n: calls.append((d, n)))
+    path = run_sweep(
+        config(tmp_path),
+        path=tmp_path / "dask.zarr",
+        scheduler=cluster.scheduler_address,
+        progress=lambda d, n: calls.append((d, n)),
+    )
     same(load_sweep(path), reference)
     assert calls[-1] == (105, 105)
     # a Client given directly works the same
@@ -268,8 +292,9 @@ def test_scheduler_local_starts_and_stops_its_own_cluster(tmp_path, monkeypatch,
     made = []
 
     def threads_cluster(workers):
-        c = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=False,
-                                     dashboard_address=":0", silence_logs=logging.ERROR)
+        c = distributed.LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=False, dashboard_address=":0", silence_logs=logging.ERROR
+        )
         made.append(c)
         return c
 
@@ -280,9 +305,16 @@ def test_scheduler_local_starts_and_stops_its_own_cluster(tmp_path, monkeypatch,
 
 
 def test_random_sweep(tmp_path, cluster):
-    cfg = config(tmp_path, sweep__kind="random", sweep__samples=300, sweep__seed=5,
-                 inertia__I2={"start": 1.5, "stop": 2.5}, momentum__polar={"start": 0.0, "stop": 180.0},
-                 momentum__azimuth={"start": 0.0, "stop": 360.0}, output__chunk=64)
+    cfg = config(
+        tmp_path,
+        sweep__kind="random",
+        sweep__samples=300,
+        sweep__seed=5,
+        inertia__I2={"start": 1.5, "stop": 2.5},
+        momentum__polar={"start": 0.0, "stop": 180.0},
+        momentum__azimuth={"start": 0.0, "stop": 360.0},
+        output__chunk=64,
+    )
     a = load_sweep(run_sweep(cfg, path=tmp_path / "r1.zarr", progress=False))
     b = load_sweep(run_sweep(cfg, path=tmp_path / "r2.zarr", scheduler=cluster.scheduler_address, progress=False))
     same(a, b)
@@ -290,8 +322,11 @@ def test_random_sweep(tmp_path, cluster):
     assert np.all((a["I2"] >= 1.5) & (a["I2"] <= 2.5))
     assert abs(float(np.cos(np.deg2rad(a["polar"])).mean())) < 0.1  # uniform on the sphere
     np.testing.assert_allclose(np.linalg.norm(a["M0"].values, axis=-1), 1.0, rtol=1e-15)
-    other = load_config(config(tmp_path, sweep__kind="random", sweep__samples=300, sweep__seed=6,
-                               inertia__I2={"start": 1.5, "stop": 2.5}))
+    other = load_config(
+        config(
+            tmp_path, sweep__kind="random", sweep__samples=300, sweep__seed=6, inertia__I2={"start": 1.5, "stop": 2.5}
+        )
+    )
     c = load_sweep(run_sweep(other, path=tmp_path / "r3.zarr", progress=False))
     assert not np.array_equal(a["I2"].values, c["I2"].values)
 
@@ -473,13 +508,25 @@ def test_plot_atlas(tmp_path, reference):
 
 
 def test_plot_random_atlas(tmp_path):
-    cfg = config(tmp_path, sweep__kind="random", sweep__samples=80, inertia__I2=2.0,
-                 momentum__polar={"start": 0.0, "stop": 180.0}, momentum__azimuth={"start": 0.0, "stop": 360.0})
+    cfg = config(
+        tmp_path,
+        sweep__kind="random",
+        sweep__samples=80,
+        inertia__I2=2.0,
+        momentum__polar={"start": 0.0, "stop": 180.0},
+        momentum__azimuth={"start": 0.0, "stop": 360.0},
+    )
     ds = load_sweep(run_sweep(cfg, progress=False))
     assert _is_png(plot_atlas(ds, tmp_path / "random.png", dpi=60))
-    cfg2 = config(tmp_path, sweep__kind="random", sweep__samples=20, inertia__I2={"start": 1.5, "stop": 2.5},
-                  momentum__polar={"start": 0.0, "stop": 180.0}, momentum__azimuth={"start": 0.0, "stop": 360.0},
-                  output__path=str(tmp_path / "r2.zarr"))
+    cfg2 = config(
+        tmp_path,
+        sweep__kind="random",
+        sweep__samples=20,
+        inertia__I2={"start": 1.5, "stop": 2.5},
+        momentum__polar={"start": 0.0, "stop": 180.0},
+        momentum__azimuth={"start": 0.0, "stop": 360.0},
+        output__path=str(tmp_path / "r2.zarr"),
+    )
     with pytest.raises(InvalidInputError, match="only for one body"):
         plot_atlas(load_sweep(run_sweep(cfg2, progress=False)), tmp_path / "no.png")
 

@@ -36,8 +36,16 @@ def _num(D, expr, n=None, ndot=None, pi=None, inertia=I_GEN, extra=None):
         sub.update(dict(zip(D.pi, pi)))
     if inertia is not None:
         I11, I12, I13, I22, I23, I33 = D.inertia_symbols
-        sub.update({I11: inertia[0, 0], I12: inertia[0, 1], I13: inertia[0, 2],
-                    I22: inertia[1, 1], I23: inertia[1, 2], I33: inertia[2, 2]})
+        sub.update(
+            {
+                I11: inertia[0, 0],
+                I12: inertia[0, 1],
+                I13: inertia[0, 2],
+                I22: inertia[1, 1],
+                I23: inertia[1, 2],
+                I33: inertia[2, 2],
+            }
+        )
     if extra:
         sub.update(extra)
     syms = list(sub)
@@ -94,7 +102,9 @@ def test_Omega_from_finite_differences(D):
 def test_A_and_Atilde(D):
     assert sp.simplify(D.A * D.Atilde - sp.eye(3)) == sp.zeros(3, 3)
     n = D.n
-    expected = sp.Matrix(3, 3, lambda i, j: int(i == j) + n[i] * n[j] + sum(S.levi_civita(i, j, k) * n[k] for k in range(3)))
+    expected = sp.Matrix(
+        3, 3, lambda i, j: int(i == j) + n[i] * n[j] + sum(S.levi_civita(i, j, k) * n[k] for k in range(3))
+    )
     assert sp.expand(D.Atilde - expected) == sp.zeros(3, 3)
 
 
@@ -151,7 +161,9 @@ def test_m_is_inertia_free_and_conserved_numerically(D):
     mf = sp.lambdify(list(D.n) + list(D.pi), D.m_canonical, "numpy")
     Kinv = np.linalg.inv(I_GEN)
     z0 = np.concatenate([[0.1, -0.2, 0.3], [1.0, -0.4, 0.7]])
-    sol = solve_ivp(lambda t, z: S.hamilton_rhs(z, Kinv), (0, 3), z0, rtol=1e-11, atol=1e-12, t_eval=np.linspace(0, 3, 7))
+    sol = solve_ivp(
+        lambda t, z: S.hamilton_rhs(z, Kinv), (0, 3), z0, rtol=1e-11, atol=1e-12, t_eval=np.linspace(0, 3, 7)
+    )
     ms = np.array([np.asarray(mf(*z), dtype=float).ravel() for z in sol.y.T])
     assert np.allclose(ms, ms[0], atol=1e-9)
     # and m = R I Omega numerically (Omega from the velocity)
@@ -176,7 +188,9 @@ def test_brackets_numeric(D):
     eps_m = np.array([[sum(S.levi_civita(i, j, k) * mv[k] for k in range(3)) for j in range(3)] for i in range(3)])
     assert np.allclose(mm_num, eps_m, atol=1e-7)
     B, C = D.brackets("nm")
-    assert sp.expand(C - sp.Matrix(3, 3, lambda i, j: sum(S.levi_civita(i, j, k) * D.m_sym[k] for k in range(3)))) == sp.zeros(3, 3)
+    assert sp.expand(
+        C - sp.Matrix(3, 3, lambda i, j: sum(S.levi_civita(i, j, k) * D.m_sym[k] for k in range(3)))
+    ) == sp.zeros(3, 3)
     assert sp.expand(B - D.Atilde / 2) == sp.zeros(3, 3)
 
 
@@ -186,7 +200,10 @@ def test_poisson_tensor_pfaffian(D):
     assert sp.simplify(P + P.T) == sp.zeros(6, 6)
     det = S.rsimp(P.det(method="berkowitz"))
     assert sp.simplify(det - (1 + D.nsq) ** 4 / 64) == 0
-    assert D.poisson_tensor("canonical") == sp.BlockMatrix([[sp.zeros(3), sp.eye(3)], [-sp.eye(3), sp.zeros(3)]]).as_explicit()
+    assert (
+        D.poisson_tensor("canonical")
+        == sp.BlockMatrix([[sp.zeros(3), sp.eye(3)], [-sp.eye(3), sp.zeros(3)]]).as_explicit()
+    )
 
 
 def test_cyclic_tensor_identity(D):

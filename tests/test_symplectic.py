@@ -160,8 +160,9 @@ def test_quaternion_field_is_hamiltonian(rng):
     p = ch.qp_from_body_momentum(q[:, None], M[:, None])
     assert abs(q @ p[:, 0]) < 1e-15
     np.testing.assert_allclose(ch.body_momentum_from_qp(q[:, None], p)[:, 0], M, rtol=1e-14)
-    np.testing.assert_allclose(ch.spatial_momentum_from_qp(q[:, None], p)[:, 0],
-                               matrix_from_quaternion(q) @ M, rtol=1e-13, atol=1e-14)
+    np.testing.assert_allclose(
+        ch.spatial_momentum_from_qp(q[:, None], p)[:, 0], matrix_from_quaternion(q) @ M, rtol=1e-13, atol=1e-14
+    )
     f = ch.quaternion_field(np.r_[q, p[:, 0]][:, None], INV)[:4, 0]
     W = np.r_[0.0, M / I3]
     np.testing.assert_allclose(f, 0.5 * ch.qmul(q[:, None], W[:, None])[:, 0], atol=1e-15)
@@ -176,15 +177,20 @@ def test_cotangent_lift_is_the_transposed_jacobian_of_the_transition(rng):
         n_new, p = random_state(rng, 0.9)
         n_old = gibbs_compose(nc, n_new)  # R(n_old) = R(nc) R(n_new)
         h = 1e-6
-        J = np.stack([(gibbs_compose(nc, n_new + h * e) - gibbs_compose(nc, n_new - h * e)) / (2 * h)
-                      for e in np.eye(3)], axis=1)  # d n_old / d n_new
+        J = np.stack(
+            [(gibbs_compose(nc, n_new + h * e) - gibbs_compose(nc, n_new - h * e)) / (2 * h) for e in np.eye(3)], axis=1
+        )  # d n_old / d n_new
         lift = ch.cotangent_lift(n_old[:, None], p[:, None], n_new[:, None])[:, 0]
         np.testing.assert_allclose(lift, J.T @ p, rtol=1e-8, atol=1e-9)
         # at n_new = 0 (the re-centring) the lift is At(n) pi = 2 I Omega: Omega unchanged
         p0 = ch.cotangent_lift(n_old[:, None], p[:, None], np.zeros((3, 1)))
         np.testing.assert_allclose(p0[:, 0], inverse_conversion_matrix(n_old) @ p, rtol=1e-14, atol=1e-14)
-        np.testing.assert_allclose(ch.omega_from_pi(np.zeros((3, 1)), p0, INV),
-                                   ch.omega_from_pi(n_old[:, None], p[:, None], INV), rtol=1e-13, atol=1e-15)
+        np.testing.assert_allclose(
+            ch.omega_from_pi(np.zeros((3, 1)), p0, INV),
+            ch.omega_from_pi(n_old[:, None], p[:, None], INV),
+            rtol=1e-13,
+            atol=1e-15,
+        )
 
 
 def test_cotangent_lift_is_canonical(rng):
@@ -303,13 +309,15 @@ def test_quadratic_invariants_exact_for_quaternion_gauss(rng):
     np.testing.assert_allclose(ch.spatial_momentum_from_qp(y[:4], y[4:]), m0, atol=1e-13)
 
 
-@pytest.mark.parametrize("opts", [{"scheme": "splitting"}, {"scheme": "splitting4"},
-                                  {"scheme": "gauss4", "variables": "quaternion"}])
+@pytest.mark.parametrize(
+    "opts", [{"scheme": "splitting"}, {"scheme": "splitting4"}, {"scheme": "gauss4", "variables": "quaternion"}]
+)
 def test_m_conserved_to_round_off(opts):
     body = [[2.0, 0.3, 0.0], [0.3, 1.5, 0.1], [0.0, 0.1, 2.5]]  # full tensor
     t = np.linspace(0.0, 60.0, 7)
-    tr = solve(body, t, omega0=[0.9, -1.3, 0.5], attitude0=[0.5, 0.5, -0.5, 0.5],
-               method="symplectic", dt=0.1, **opts)  # ~0.2 rad per step, 600 steps
+    tr = solve(
+        body, t, omega0=[0.9, -1.3, 0.5], attitude0=[0.5, 0.5, -0.5, 0.5], method="symplectic", dt=0.1, **opts
+    )  # ~0.2 rad per step, 600 steps
     d = tr.drift()
     assert max(d["m_x"], d["m_y"], d["m_z"], d["m_norm"]) < 1e-13, d
     assert 1e-12 < d["energy"] < 1e-2  # energy is not exact
@@ -337,10 +345,13 @@ def windowed_drift(E, nwin=10):
     return w, slope * nwin / w.max()
 
 
-@pytest.mark.parametrize("opts,nsteps,bound", [
-    ({"scheme": "splitting"}, 100_000, 1e-3),
-    ({"scheme": "gauss2", "variables": "quaternion"}, 3_000, 1e-3),
-])
+@pytest.mark.parametrize(
+    "opts,nsteps,bound",
+    [
+        ({"scheme": "splitting"}, 100_000, 1e-3),
+        ({"scheme": "gauss2", "variables": "quaternion"}, 3_000, 1e-3),
+    ],
+)
 def test_energy_error_bounded_without_drift(opts, nsteps, bound):
     """Long runs (0.2 rad per step): the windowed max energy error does not grow."""
     dt = 0.2 / np.linalg.norm(W0)
@@ -367,14 +378,23 @@ def test_gibbs_chart_changes_make_the_energy_drift_like_h_to_the_p():
 # ---------------------------------------------------------------------------
 # accuracy through the public API
 # ---------------------------------------------------------------------------
-@pytest.mark.parametrize("opts,tol", [  # measured errors x 3 (0.03 rad per step over 9 time units)
-    ({"scheme": "gauss2", "variables": "gibbs"}, 6e-3), ({"scheme": "gauss4", "variables": "gibbs"}, 5e-8),
-    ({"scheme": "gauss6", "variables": "gibbs"}, 3e-12),
-    ({"scheme": "gauss4", "variables": "quaternion"}, 2e-8), ({"scheme": "gauss6", "variables": "quaternion"}, 1e-12),
-    ({"scheme": "gauss4", "variables": "gibbs", "chart_threshold": 0.0}, 7e-8),
-    ({"scheme": "gauss4", "variables": "gibbs", "chart_threshold": 3.0}, 3e-7),  # larger |n|: larger error constants
-    ({"scheme": "splitting"}, 1.2e-4), ({"scheme": "splitting4"}, 1.5e-7),
-])
+@pytest.mark.parametrize(
+    "opts,tol",
+    [  # measured errors x 3 (0.03 rad per step over 9 time units)
+        ({"scheme": "gauss2", "variables": "gibbs"}, 6e-3),
+        ({"scheme": "gauss4", "variables": "gibbs"}, 5e-8),
+        ({"scheme": "gauss6", "variables": "gibbs"}, 3e-12),
+        ({"scheme": "gauss4", "variables": "quaternion"}, 2e-8),
+        ({"scheme": "gauss6", "variables": "quaternion"}, 1e-12),
+        ({"scheme": "gauss4", "variables": "gibbs", "chart_threshold": 0.0}, 7e-8),
+        (
+            {"scheme": "gauss4", "variables": "gibbs", "chart_threshold": 3.0},
+            3e-7,
+        ),  # larger |n|: larger error constants
+        ({"scheme": "splitting"}, 1.2e-4),
+        ({"scheme": "splitting4"}, 1.5e-7),
+    ],
+)
 def test_schemes_agree_with_reference(opts, tol):
     body = [[2.0, 0.3, 0.0], [0.3, 1.5, 0.1], [0.0, 0.1, 2.5]]
     q0 = np.array([0.5, 0.5, -0.5, 0.5])
@@ -406,18 +426,21 @@ def test_body_at_rest():
 # ---------------------------------------------------------------------------
 # errors
 # ---------------------------------------------------------------------------
-@pytest.mark.parametrize("opts,match", [
-    ({"scheme": "gauss8"}, "unknown scheme"),
-    ({"scheme": 4}, "unknown scheme"),
-    ({"variables": "euler"}, "unknown variables"),
-    ({"dt": 0.0}, "dt must be"),
-    ({"dt": float("nan")}, "dt must be"),
-    ({"dt": "0.1"}, "dt must be"),
-    ({"max_iter": 0}, "max_iter"),
-    ({"max_iter": 2.5}, "max_iter"),
-    ({"chart_threshold": -1.0}, "chart_threshold"),
-    ({"chart_threshold": "big"}, "chart_threshold"),
-])
+@pytest.mark.parametrize(
+    "opts,match",
+    [
+        ({"scheme": "gauss8"}, "unknown scheme"),
+        ({"scheme": 4}, "unknown scheme"),
+        ({"variables": "euler"}, "unknown variables"),
+        ({"dt": 0.0}, "dt must be"),
+        ({"dt": float("nan")}, "dt must be"),
+        ({"dt": "0.1"}, "dt must be"),
+        ({"max_iter": 0}, "max_iter"),
+        ({"max_iter": 2.5}, "max_iter"),
+        ({"chart_threshold": -1.0}, "chart_threshold"),
+        ({"chart_threshold": "big"}, "chart_threshold"),
+    ],
+)
 def test_bad_options(opts, match):
     with pytest.raises(InvalidInputError, match=match):
         solve(I3, [0.0, 1.0], omega0=W0, method="symplectic", **opts)

@@ -49,14 +49,16 @@ def numpy_path(monkeypatch):
 def test_sincos_against_mpmath(rng):
     mpmath = pytest.importorskip("mpmath")
     mpmath.mp.dps = 40
-    x = np.concatenate([
-        rng.uniform(-4, 4, 600),
-        rng.uniform(-1e3, 1e3, 200),
-        rng.uniform(-5e5, 5e5, 200),  # still reduced by Cody-Waite
-        rng.uniform(5.3e5, 1e8, 50) * rng.choice([-1, 1], 50),  # libm
-        np.arange(-40, 41) * (np.pi / 4),  # quadrant boundaries
-        rng.uniform(-1e-4, 1e-4, 50),
-    ])
+    x = np.concatenate(
+        [
+            rng.uniform(-4, 4, 600),
+            rng.uniform(-1e3, 1e3, 200),
+            rng.uniform(-5e5, 5e5, 200),  # still reduced by Cody-Waite
+            rng.uniform(5.3e5, 1e8, 50) * rng.choice([-1, 1], 50),  # libm
+            np.arange(-40, 41) * (np.pi / 4),  # quadrant boundaries
+            rng.uniform(-1e-4, 1e-4, 50),
+        ]
+    )
     s, c = K.sincos_numpy(x)
     for val, f in ((s, mpmath.sin), (c, mpmath.cos)):
         exact = np.array([float(f(mpmath.mpf(float(v)))) for v in x])
@@ -68,13 +70,19 @@ def test_sincos_against_mpmath(rng):
 
 
 def test_sincos_paths_bitwise(rng):
-    x = np.concatenate([rng.uniform(-10, 10, 3000), rng.uniform(-1e6, 1e6, 300), np.arange(-20, 21) * (np.pi / 4),
-                        [0.0, -0.0, 1e-300, 2.0**19, -(2.0**19) - 1.0, 1e12]])
+    x = np.concatenate(
+        [
+            rng.uniform(-10, 10, 3000),
+            rng.uniform(-1e6, 1e6, 300),
+            np.arange(-20, 21) * (np.pi / 4),
+            [0.0, -0.0, 1e-300, 2.0**19, -(2.0**19) - 1.0, 1e12],
+        ]
+    )
     s, c = K.sincos_numpy(x)  # vectorized NumPy
     for k in range(0, x.size, 997):  # the Python-float path for a few values
-        s1, c1 = K.sincos_numpy(x[k:k + 3])
-        np.testing.assert_array_equal(s1, s[k:k + 3])
-        np.testing.assert_array_equal(c1, c[k:k + 3])
+        s1, c1 = K.sincos_numpy(x[k : k + 3])
+        np.testing.assert_array_equal(s1, s[k : k + 3])
+        np.testing.assert_array_equal(c1, c[k : k + 3])
     if K.USE_NUMBA:
         s2, c2 = K.sincos_compiled(x)
         np.testing.assert_array_equal(s2, s)
@@ -90,10 +98,16 @@ def test_sincos_paths_bitwise(rng):
 # ---------------------------------------------------------------------------
 # the schedule
 # ---------------------------------------------------------------------------
-@pytest.mark.parametrize("t,dt", [
-    (TIMES, 0.1), (TIMES, 0.3), (np.array([3.0]), math.inf), (np.array([-2.0, -2.0, 0.0]), 0.7),
-    (np.linspace(0.0, 1.0, 11), 0.1),  # multiples of dt up to rounding: exactly one step each
-])
+@pytest.mark.parametrize(
+    "t,dt",
+    [
+        (TIMES, 0.1),
+        (TIMES, 0.3),
+        (np.array([3.0]), math.inf),
+        (np.array([-2.0, -2.0, 0.0]), 0.7),
+        (np.linspace(0.0, 1.0, 11), 0.1),  # multiples of dt up to rounding: exactly one step each
+    ],
+)
 def test_schedule_is_the_steps_of_run_fixed_step(t, dt):
     calls = []
 
@@ -179,8 +193,13 @@ def test_no_numba_subprocess_matches(tmp_path):
     """)
     path = tmp_path / "numpy_path.npz"
     env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
-    res = subprocess.run([sys.executable, "-c", script, str(path), json.dumps(TIMES.tolist())],
-                         env=env, capture_output=True, text=True, timeout=300)
+    res = subprocess.run(
+        [sys.executable, "-c", script, str(path), json.dumps(TIMES.tolist())],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert res.returncode == 0, res.stderr
     flags = json.loads(res.stdout.strip().splitlines()[-1])
     assert not any(flags.values())  # the child used NumPy
@@ -201,11 +220,15 @@ def test_no_numba_subprocess_matches(tmp_path):
 # edge cases
 # ---------------------------------------------------------------------------
 @numba_only
-@pytest.mark.parametrize("opts", [
-    {"t": [0.0, 100.0], "dt": 50.0},  # diverges
-    {"t": [0.0, 1.0], "max_iter": 2},  # does not converge in 2 iterations
-    {"t": [0.0, 1.0], "dt": 1.0, "omega0": [1e160, 2e160, 0.0]},  # overflows: non-finite stages
-], ids=["diverged", "max_iter", "nonfinite"])
+@pytest.mark.parametrize(
+    "opts",
+    [
+        {"t": [0.0, 100.0], "dt": 50.0},  # diverges
+        {"t": [0.0, 1.0], "max_iter": 2},  # does not converge in 2 iterations
+        {"t": [0.0, 1.0], "dt": 1.0, "omega0": [1e160, 2e160, 0.0]},  # overflows: non-finite stages
+    ],
+    ids=["diverged", "max_iter", "nonfinite"],
+)
 def test_failures_same_as_numpy(opts, monkeypatch):
     opts = dict(opts)
     t = opts.pop("t")
@@ -230,8 +253,9 @@ def test_giant_splitting_steps_use_libm(monkeypatch):
     np.testing.assert_allclose(fast.quaternion, slow.quaternion, rtol=0, atol=1e-15)
     np.testing.assert_allclose(fast.omega, slow.omega, rtol=0, atol=1e-15)
     M = fast.M
-    np.testing.assert_allclose(np.linalg.norm(M, axis=-1), np.linalg.norm(I3 * w0, axis=-1)[:, None].repeat(2, 1),
-                               rtol=1e-14)
+    np.testing.assert_allclose(
+        np.linalg.norm(M, axis=-1), np.linalg.norm(I3 * w0, axis=-1)[:, None].repeat(2, 1), rtol=1e-14
+    )
     np.testing.assert_allclose(fast.m, (I3 * w0)[:, None, :].repeat(2, 1), rtol=0, atol=1e-13)
 
 
@@ -242,8 +266,7 @@ def test_large_batch_keeps_integrals(scheme, rng):
     B = 500
     w0, q0 = random_batch(rng, B, scale=1.0)
     w0 /= np.linalg.norm(w0, axis=1, keepdims=True)
-    tr = solve(FULL, np.linspace(0.0, 200.0, 5), omega0=w0, attitude0=q0, method="symplectic",
-               scheme=scheme, dt=0.1)
+    tr = solve(FULL, np.linspace(0.0, 200.0, 5), omega0=w0, attitude0=q0, method="symplectic", scheme=scheme, dt=0.1)
     assert tr.stats["steps"] == 2000 and tr.stats["compiled"]
     m = tr.m
     # round-off only: a random walk of ~1e-16 |m| per rotation (24000 rotations for splitting4);

@@ -206,9 +206,13 @@ def test_lie_series_terms_match_symbolic_audit(case):
     else:
         order = 4
         # R diag(1, 3/2, 2) R^T with the rational rotation R = [[2,-1,2],[2,2,-1],[-1,2,2]]/3
-        Isym = sp.Matrix([[sp.Rational(3, 2), sp.Rational(-1, 3), sp.Rational(1, 3)],
-                          [sp.Rational(-1, 3), sp.Rational(4, 3), 0],
-                          [sp.Rational(1, 3), 0, sp.Rational(5, 3)]])
+        Isym = sp.Matrix(
+            [
+                [sp.Rational(3, 2), sp.Rational(-1, 3), sp.Rational(1, 3)],
+                [sp.Rational(-1, 3), sp.Rational(4, 3), 0],
+                [sp.Rational(1, 3), 0, sp.Rational(5, 3)],
+            ]
+        )
         n0 = [sp.Rational(1, 5), sp.Rational(-1, 10), sp.Rational(3, 10)]
         I = np.array(Isym.tolist(), dtype=float)
         inertia = I
@@ -300,7 +304,8 @@ def test_mpmath_integration_converges_to_30_digits(mp_truth):
             q, om, st = integrate_principal(m, w0, tt, tol=tol)
             assert st["backend"] == "numpy" and st["max_order"] == auto_order(tol)
             err = max(
-                max(abs(q[i, c] - mp_truth[tk][c]) for c in range(4)) + max(abs(om[i, c] - mp_truth[tk][4 + c]) for c in range(3))
+                max(abs(q[i, c] - mp_truth[tk][c]) for c in range(4))
+                + max(abs(om[i, c] - mp_truth[tk][4 + c]) for c in range(3))
                 for i, tk in enumerate(t)
             )
             errs.append(float(err))
@@ -356,8 +361,12 @@ def test_float64_round_off_is_compensated():
     m[0] = I123
     t = np.array([100.0])
     qr, wr, _ = integrate_principal(
-        m.astype(ld), w0.astype(ld), t.astype(ld), q0=np.tile(np.array([1, 0, 0, 0], ld), (8, 1)),
-        tol=2e-19, backend="numpy",
+        m.astype(ld),
+        w0.astype(ld),
+        t.astype(ld),
+        q0=np.tile(np.array([1, 0, 0, 0], ld), (8, 1)),
+        tol=2e-19,
+        backend="numpy",
     )
     for backend in ("auto", "numpy"):
         q, om, _ = integrate_principal(m, w0, t, tol=EPS, backend=backend)
@@ -601,8 +610,14 @@ def test_lane_kernel_logic_equals_scalar_kernel_bit_for_bit_in_python():
     t = np.array([1.5, -2.0, 0.0, 4.0, 1.5])
     args = [json.dumps(np.where(np.isnan(x), None, x).tolist()) for x in (m, w0, q0, t)]
     env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
-    out = subprocess.run([sys.executable, "-c", _LANES_PY_SCRIPT, *args], env=env, capture_output=True,
-                         text=True, timeout=300, check=True)
+    out = subprocess.run(
+        [sys.executable, "-c", _LANES_PY_SCRIPT, *args],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    )
     res = json.loads(out.stdout.strip().splitlines()[-1])
     assert res["use_numba"] is False
     assert res["equal"] == [True, True, True]
@@ -675,7 +690,11 @@ def test_numpy_fallback_in_subprocess_matches():
     env = dict(os.environ, EULERPOISSON_NO_NUMBA="1")
     out = subprocess.run(
         [sys.executable, "-c", _FALLBACK_SCRIPT, json.dumps(I), json.dumps(w0), json.dumps(t)],
-        env=env, capture_output=True, text=True, timeout=120, check=True,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
     )
     res = json.loads(out.stdout.strip().splitlines()[-1])
     assert res["use_numba"] is False and res["backend"] == "numpy"

@@ -50,8 +50,18 @@ _cache = {}
 def run(name, inertia=I_FULL, q0=Q0, w0=W0, t=TIMES, dps=40, order=None, **kw):
     """Memoised reference run (the mp version), so that one run serves several tests."""
     kw = dict(CASES[name], **kw) if name in CASES else kw
-    key = repr((name, dps, order, np.asarray(inertia).tolist(), np.asarray(q0).tolist(), np.asarray(w0).tolist(),
-                np.asarray(t).tolist(), sorted((k, _plain(v)) for k, v in kw.items())))
+    key = repr(
+        (
+            name,
+            dps,
+            order,
+            np.asarray(inertia).tolist(),
+            np.asarray(q0).tolist(),
+            np.asarray(w0).tolist(),
+            np.asarray(t).tolist(),
+            sorted((k, _plain(v)) for k, v in kw.items()),
+        )
+    )
     if key not in _cache:
         _cache[key] = tr.reference_motion_mp(inertia, q0, w0, t, dps=dps, order=order, **kw)
     return _cache[key]
@@ -86,15 +96,25 @@ def max_abs_diff(a, b):
 def _qmul(p, q):
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return np.array([pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-                     pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw])
+    return np.array(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ]
+    )
 
 
 def _rot(q):
     w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def dop853(inertia, q0, w0, t, gravity=None, gravity_gradient=None, body_torque=None, space_torque=None):
@@ -135,7 +155,7 @@ def test_agrees_with_dop853(name):
 
 
 def test_float_api_matches_mp_api_and_handles_time_order():
-    t = np.array([7.5, 0.0, 2.5, 7.5, 10.0])       # unsorted, with a repeat and t = 0
+    t = np.array([7.5, 0.0, 2.5, 7.5, 10.0])  # unsorted, with a repeat and t = 0
     q, w = tr.reference_motion(I_FULL, Q0, W0, t, gravity=HEAVY)
     assert q.shape == (5, 4) and w.shape == (5, 3) and q.dtype == np.float64
     qm, wm = run("gravity")
@@ -144,7 +164,7 @@ def test_float_api_matches_mp_api_and_handles_time_order():
     np.testing.assert_array_equal(w, as_float(wm)[idx])
     np.testing.assert_allclose(q[1], Q0, rtol=0, atol=3e-16)
     np.testing.assert_array_equal(w[1], W0)
-    qs, ws = tr.reference_motion(I_FULL, Q0, W0, 2.5, gravity=HEAVY)   # scalar time
+    qs, ws = tr.reference_motion(I_FULL, Q0, W0, 2.5, gravity=HEAVY)  # scalar time
     np.testing.assert_array_equal(qs[0], q[2])
     np.testing.assert_array_equal(ws[0], w[2])
     with pytest.raises(ValueError):
@@ -171,7 +191,7 @@ def test_vertical_momentum_and_area_conserved():
     v = tr.vertical_momentum(I_FULL, q, w, G)
     a = tr.area_integral(I_FULL, q, w, G)
     assert max_rel_drift(v) < 1e-25
-    with mpmath.workdps(60):        # mpf arithmetic rounds to the *current* precision (15 digits by default)
+    with mpmath.workdps(60):  # mpf arithmetic rounds to the *current* precision (15 digits by default)
         assert max(abs(x + y) for x, y in zip(v, a)) < 1e-40
 
 
@@ -202,7 +222,7 @@ def test_lagrange_top():
     assert max_rel_drift(tr.lagrange_m3(I, w)) < 1e-25
     assert max_rel_drift(tr.energy(I, q, w, grav)) < 1e-25
     assert max_rel_drift(tr.vertical_momentum(I, q, w, G)) < 1e-25
-    assert abs(float(w[-1][0]) - w0[0]) > 1e-2      # a non-trivial motion
+    assert abs(float(w[-1][0]) - w0[0]) > 1e-2  # a non-trivial motion
 
 
 @pytest.mark.parametrize("c", [(0.4, 0.0, 0.0), (0.25, -0.3, 0.0)])
@@ -226,7 +246,7 @@ def test_kovalevskaya_formula_matches_the_written_form():
     with mpmath.workdps(50):
         R = tr.rotation_matrix(q)
         w = [mpmath.mpf(a) for a in w]
-        gam = [R[2][i] for i in range(3)]        # R^T e_z (g = -9.81 e_z)
+        gam = [R[2][i] for i in range(3)]  # R^T e_z (g = -9.81 e_z)
         mu = mpmath.mpf(1.3) * mpmath.mpf(9.81) * mpmath.mpf(0.4) / mpmath.mpf(0.7)
         K = (w[0] ** 2 - w[1] ** 2 - mu * gam[0]) ** 2 + (2 * w[0] * w[1] - mu * gam[1]) ** 2
         assert abs(K - tr.kovalevskaya_integral(I, q, w, 1.3, [0.4, 0, 0], G)) < 1e-40
@@ -251,7 +271,7 @@ def test_goryachev_chaplygin_on_zero_area(c_y):
     assert max_rel_drift(Gc) < 1e-25
     # the '+' sign (G = w3 (w1^2 + w2^2) + mu w1 gamma3) is not conserved
     assert max_rel_drift(tr.goryachev_chaplygin_integral(I, q, w, -1.3, c, G)) > 1e-2
-    assert abs(float(w[-1][2])) > 1e-2      # a non-trivial motion
+    assert abs(float(w[-1][2])) > 1e-2  # a non-trivial motion
 
 
 def test_goryachev_chaplygin_needs_zero_area():
@@ -302,7 +322,7 @@ def test_precisions_and_step_controls_agree(name):
     q40, w40 = run(name)
     q30, w30 = run(name, dps=30)
     q45, w45 = run(name, dps=45)
-    qo, wo = run(name, order=30)      # different order, hence a different step sequence
+    qo, wo = run(name, order=30)  # different order, hence a different step sequence
     assert max_abs_diff(q30 + w30, q45 + w45) < 1e-25
     assert max_abs_diff(q40 + w40, q45 + w45) < 1e-35
     assert max_abs_diff(qo + wo, q45 + w45) < 1e-35
@@ -334,8 +354,12 @@ def test_body_torque_from_rest_about_principal_axis(axis):
 def _qmul_mp(p, q):
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return [pw * qw - px * qx - py * qy - pz * qz, pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx, pw * qz + px * qy - py * qx + pz * qw]
+    return [
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    ]
 
 
 def test_free_symmetric_top_closed_form():

@@ -30,11 +30,21 @@ def _gravity_ref(mass, c, g=G):
 
 # name: (inertia, q0, omega0, torque, reference kwargs)
 CASES = {
-    "lagrange": ([1.0, 1.0, 0.5], Q0, np.array([0.3, -0.2, 12.0]), Gravity(1.0, [0, 0, 0.1]),
-                 _gravity_ref(1.0, [0, 0, 0.1])),
+    "lagrange": (
+        [1.0, 1.0, 0.5],
+        Q0,
+        np.array([0.3, -0.2, 12.0]),
+        Gravity(1.0, [0, 0, 0.1]),
+        _gravity_ref(1.0, [0, 0, 0.1]),
+    ),
     "asymmetric_full_tensor": (I_FULL, Q0, W0, Gravity(1.3, [0.1, -0.2, 0.4]), _gravity_ref(1.3, [0.1, -0.2, 0.4])),
-    "kovalevskaya": ([2.0, 2.0, 1.0], Q0, np.array([0.4, 1.1, -0.5]), Gravity(0.2, [0.5, 0.0, 0.0]),
-                     _gravity_ref(0.2, [0.5, 0.0, 0.0])),
+    "kovalevskaya": (
+        [2.0, 2.0, 1.0],
+        Q0,
+        np.array([0.4, 1.1, -0.5]),
+        Gravity(0.2, [0.5, 0.0, 0.0]),
+        _gravity_ref(0.2, [0.5, 0.0, 0.0]),
+    ),
     "gravity_gradient": (I_FULL, Q0, W0, GravityGradient(0.9), dict(gravity_gradient=0.9)),
     "body_torque": (I_FULL, Q0, W0, BodyTorque([0.3, -0.1, 0.2]), dict(body_torque=[0.3, -0.1, 0.2])),
     "space_torque": (I_FULL, Q0, W0, SpaceTorque([0.3, -0.1, 0.2]), dict(space_torque=[0.3, -0.1, 0.2])),
@@ -70,8 +80,9 @@ def test_taylor_agrees_with_high_precision_reference_at_t10(name):
 def test_rk_dop853_agrees_with_reference_at_t10(name):
     inertia, q0, w0, torque, _ = CASES[name]
     qr, wr = _reference(name)
-    tr = ep.solve(inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", integrator="DOP853",
-                  tol=1e-13)
+    tr = ep.solve(
+        inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", integrator="DOP853", tol=1e-13
+    )
     dq, dw = _errors(tr, qr, wr)
     assert dq <= 1e-9 and dw <= 1e-9, (name, dq, dw)
 
@@ -81,8 +92,7 @@ def test_rk_gibbs_charts_see_the_full_attitude(name):
     """In charts R = R_c R(n) the torque must use R_c too (no left invariance under torque)."""
     inertia, q0, w0, torque, _ = CASES[name]
     qr, wr = _reference(name)
-    tr = ep.solve(inertia, [10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", formulation="gibbs",
-                  tol=1e-13)
+    tr = ep.solve(inertia, [10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", formulation="gibbs", tol=1e-13)
     assert tr.stats["chart_changes"] > 0
     dq, dw = _errors(tr, qr, wr)
     assert dq <= 1e-9 and dw <= 1e-9, (name, dq, dw)
@@ -96,8 +106,9 @@ def test_exact_splitting_converges_at_its_order(name, scheme, order):
     qr, wr = _reference(name, t_end)
     errs = []
     for dt in (0.02, 0.01, 0.005):
-        tr = ep.solve(inertia, [t_end], omega0=w0, attitude0=q0, torque=torque, method="symplectic", scheme=scheme,
-                      dt=dt)
+        tr = ep.solve(
+            inertia, [t_end], omega0=w0, attitude0=q0, torque=torque, method="symplectic", scheme=scheme, dt=dt
+        )
         errs.append(sum(_errors(tr, qr, wr)))
     slopes = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     assert np.all(np.abs(slopes - order) < 0.3), (errs, slopes)
@@ -107,13 +118,14 @@ def test_exact_splitting_energy_bounded_over_a_million_steps():
     """Heavy asymmetric top: the energy error oscillates without drift over 10^6 steps (symplectic)."""
     inertia, q0, w0, torque, _ = CASES["asymmetric_full_tensor"]
     t = np.linspace(0.0, 20000.0, 2001)
-    tr = ep.solve(inertia, t, omega0=w0, attitude0=q0, torque=torque, method="symplectic", scheme="exact_splitting",
-                  dt=0.02)
+    tr = ep.solve(
+        inertia, t, omega0=w0, attitude0=q0, torque=torque, method="symplectic", scheme="exact_splitting", dt=0.02
+    )
     assert tr.stats["steps"] == 1_000_000
     E = tr.energy
     scale = tr.kinetic_energy[0] + abs(tr.potential_energy[0])
     err = np.abs(E - E[0]) / scale
-    first, last = err[: len(err) // 10].max(), err[-len(err) // 10:].max()
+    first, last = err[: len(err) // 10].max(), err[-len(err) // 10 :].max()
     assert err.max() < 1e-3
     assert last < 2.0 * first, (first, last)  # no secular growth
     # the vertical angular momentum is conserved by both flows: round-off only
@@ -180,8 +192,7 @@ def test_batches_of_bodies_and_torque_parameters_equal_one_by_one():
         batch = ep.solve([1.0, 1.2, 0.6], t, omega0=w0, torque=top, method=method, **opts)
         assert batch.quaternion.shape == (3, 4, 4)
         for b in range(3):
-            one = ep.solve([1.0, 1.2, 0.6], t, omega0=w0[b], torque=Gravity(masses[b], coms[b]), method=method,
-                           **opts)
+            one = ep.solve([1.0, 1.2, 0.6], t, omega0=w0[b], torque=Gravity(masses[b], coms[b]), method=method, **opts)
             np.testing.assert_array_equal(batch.quaternion[b], one.quaternion)
             np.testing.assert_array_equal(batch.omega[b], one.omega)
 
@@ -189,8 +200,7 @@ def test_batches_of_bodies_and_torque_parameters_equal_one_by_one():
 def test_negative_times_run_backwards_under_torque():
     inertia, q0, w0, torque, _ = CASES["asymmetric_full_tensor"]
     fwd = ep.solve(inertia, [1.5], omega0=w0, attitude0=q0, torque=torque, method="taylor")
-    back = ep.solve(inertia, [-1.5], omega0=fwd.omega[-1], attitude0=fwd.quaternion[-1], torque=torque,
-                    method="taylor")
+    back = ep.solve(inertia, [-1.5], omega0=fwd.omega[-1], attitude0=fwd.quaternion[-1], torque=torque, method="taylor")
     assert quaternion_distance(back.quaternion[-1], q0) < 1e-13
     np.testing.assert_allclose(back.omega[-1], w0, atol=1e-13)
 
@@ -233,7 +243,9 @@ def test_every_method_handles_or_refuses_every_torque(method, tname):
     model = ep.Model(inertia, torque)
     reason = get_method(method).supports(model)
     if reason is not None:
-        with pytest.raises(UnsupportedModelError, match=rf"method '{method}' cannot run this model: .*methods that can: .*rk"):
+        with pytest.raises(
+            UnsupportedModelError, match=rf"method '{method}' cannot run this model: .*methods that can: .*rk"
+        ):
             ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method=method)
         return
     tr = ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method=method)
@@ -245,8 +257,7 @@ def test_every_method_handles_or_refuses_every_torque(method, tname):
 
 def test_symplectic_free_body_schemes_refuse_torque():
     with pytest.raises(UnsupportedModelError, match="scheme 'gauss4' solves the free body only.*exact_splitting"):
-        ep.solve([1, 2, 3], [1.0], omega0=[1, 0, 0], torque=GravityGradient(0.1), method="symplectic",
-                 scheme="gauss4")
+        ep.solve([1, 2, 3], [1.0], omega0=[1, 0, 0], torque=GravityGradient(0.1), method="symplectic", scheme="gauss4")
 
 
 def test_exact_splitting_without_torque_is_the_closed_form():
@@ -284,8 +295,12 @@ def test_model_torque_matches_definitions():
 
 
 def test_torque_records_round_trip_through_netcdf(tmp_path):
-    torque = [Gravity(1.5, [0, 0.1, 0.2], [0, -9.8, 0]), GravityGradient(0.01), BodyTorque([1, 2, 3]),
-              SpaceTorque([0, 0, 1])]
+    torque = [
+        Gravity(1.5, [0, 0.1, 0.2], [0, -9.8, 0]),
+        GravityGradient(0.01),
+        BodyTorque([1, 2, 3]),
+        SpaceTorque([0, 0, 1]),
+    ]
     tr = ep.solve(I_FULL, [0.0, 0.5], omega0=W0, torque=torque, method="rk")
     tr.to_netcdf(tmp_path / "run.nc")
     back = ep.Trajectory.from_netcdf(tmp_path / "run.nc")
@@ -356,8 +371,9 @@ def test_exact_lagrange_batches_equal_one_by_one_and_other_tops_are_refused():
     t = np.linspace(-2, 5, 8)
     batch = ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(masses, [0, 0, 0.1]), method="exact")
     for b in range(3):
-        one = ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(masses[b], [0, 0, 0.1]),
-                       method="exact")
+        one = ep.solve(
+            [1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(masses[b], [0, 0, 0.1]), method="exact"
+        )
         np.testing.assert_allclose(batch.quaternion[b], one.quaternion, atol=1e-15)
     with pytest.raises(UnsupportedModelError, match="Lagrange top.*methods that can: rk, symplectic, taylor"):
         ep.solve([1.0, 1.0, 0.5], t, omega0=[0.1, 0.2, 10], torque=Gravity(1.0, [0.1, 0, 0.1]), method="exact")

@@ -98,8 +98,11 @@ def test_from_netcdf_path_type(arg):
 def test_from_netcdf_good_files_round_trip_bit_exact(tmp_path):
     pytest.importorskip("xarray")
     pytest.importorskip("h5netcdf")
-    tr = solve(RigidBody.from_moments([[1.0, 2.0, 2.5], [2.0, 2.0, 3.0]]), np.linspace(0, 2, 4),
-               omega0=[[0.3, -1.0, 0.2], [1.0, 0.5, 0.1]])
+    tr = solve(
+        RigidBody.from_moments([[1.0, 2.0, 2.5], [2.0, 2.0, 3.0]]),
+        np.linspace(0, 2, 4),
+        omega0=[[0.3, -1.0, 0.2], [1.0, 0.5, 0.1]],
+    )
     tr.to_netcdf(tmp_path / "b.nc")
     back = Trajectory.from_netcdf(tmp_path / "b.nc")
     for a in ("t", "quaternion", "omega"):
@@ -342,8 +345,9 @@ def test_from_particles_scales_exactly(rng):
 
 def test_from_particles_out_of_range_messages():
     pos = np.eye(3)
-    with pytest.raises(InvalidInputError,
-                       match=r"overflows float64 \(masses up to 1 and positions .* up to 6\.66667e\+199"):
+    with pytest.raises(
+        InvalidInputError, match=r"overflows float64 \(masses up to 1 and positions .* up to 6\.66667e\+199"
+    ):
         RigidBody.from_particles([1.0, 1.0, 1.0], 1e200 * pos)
     with pytest.raises(InvalidInputError, match=r"underflows float64 .*positions relative to the centre of mass"):
         RigidBody.from_particles([1.0, 1.0, 1.0], 1e-200 * pos)

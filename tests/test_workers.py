@@ -28,7 +28,6 @@ WORKERS = (2, 3, 7)
 TIMES = np.array([0.0, 0.7, -1.3, 3.0])
 
 
-
 def _same_bits(a, b) -> bool:
     """The same shape and the same bits (``np.array_equal`` would take -0.0 == +0.0)."""
     a, b = np.ascontiguousarray(a), np.ascontiguousarray(b)
@@ -65,8 +64,9 @@ def _cases(n):
     rng = np.random.default_rng(1000 + n)
     w = 2.0 * rng.standard_normal((n, 3))
     q = _unit_quaternions(rng, n)
-    top = ep.torques.Gravity(mass=rng.uniform(0.5, 2.0, n),
-                             center_of_mass=np.c_[np.zeros((n, 2)), rng.uniform(-0.5, 0.5, n)])
+    top = ep.torques.Gravity(
+        mass=rng.uniform(0.5, 2.0, n), center_of_mass=np.c_[np.zeros((n, 2)), rng.uniform(-0.5, 0.5, n)]
+    )
     heavy = ep.torques.Gravity(mass=rng.uniform(0.5, 2.0, n), center_of_mass=rng.uniform(-0.5, 0.5, (n, 3)))
     tensors = _tensors(rng, n)
     # diagonal tensors among full ones: the body frame is principal for some bodies only; the first half
@@ -75,21 +75,25 @@ def _cases(n):
     half = (n + 1) // 2
     mixed[:half] = np.einsum("bi,ij->bij", np.diagonal(tensors[:half], axis1=1, axis2=2), np.eye(3))
     w[::3, 1] = -0.0
-    return {
-        "exact-free": dict(body=[1.0, 2.0, 3.0], method="exact"),
-        "exact-tensors": dict(body=tensors, method="exact"),
-        "exact-mixed-frames": dict(body=mixed, method="exact"),
-        "exact-lagrange-top": dict(body=[2.0, 2.0, 1.0], torque=top, method="exact"),
-        "taylor-free": dict(body=[1.0, 2.0, 3.0], method="taylor"),
-        "taylor-tensors": dict(body=tensors, method="taylor"),
-        "taylor-mixed-frames": dict(body=mixed, method="taylor"),
-        "taylor-gravity": dict(body=[1.0, 2.0, 3.0], torque=heavy, method="taylor"),
-        "symplectic-gauss4": dict(body=[1.0, 2.0, 3.0], method="symplectic"),
-        "symplectic-tensors": dict(body=tensors, method="symplectic"),
-        "symplectic-mixed-frames": dict(body=mixed, method="symplectic"),
-        "symplectic-splitting4": dict(body=[1.0, 2.0, 3.0], method="symplectic", scheme="splitting4"),
-        "symplectic-gravity": dict(body=[1.0, 2.0, 3.0], torque=heavy, method="symplectic"),
-    }, w, q
+    return (
+        {
+            "exact-free": dict(body=[1.0, 2.0, 3.0], method="exact"),
+            "exact-tensors": dict(body=tensors, method="exact"),
+            "exact-mixed-frames": dict(body=mixed, method="exact"),
+            "exact-lagrange-top": dict(body=[2.0, 2.0, 1.0], torque=top, method="exact"),
+            "taylor-free": dict(body=[1.0, 2.0, 3.0], method="taylor"),
+            "taylor-tensors": dict(body=tensors, method="taylor"),
+            "taylor-mixed-frames": dict(body=mixed, method="taylor"),
+            "taylor-gravity": dict(body=[1.0, 2.0, 3.0], torque=heavy, method="taylor"),
+            "symplectic-gauss4": dict(body=[1.0, 2.0, 3.0], method="symplectic"),
+            "symplectic-tensors": dict(body=tensors, method="symplectic"),
+            "symplectic-mixed-frames": dict(body=mixed, method="symplectic"),
+            "symplectic-splitting4": dict(body=[1.0, 2.0, 3.0], method="symplectic", scheme="splitting4"),
+            "symplectic-gravity": dict(body=[1.0, 2.0, 3.0], torque=heavy, method="symplectic"),
+        },
+        w,
+        q,
+    )
 
 
 CASE_NAMES = list(_cases(1)[0])

@@ -13,6 +13,7 @@ source time is kept as ``t_phyphox``.
 
 Run:  python extract.py    (writes phone_toss_1.csv, phone_toss_2.csv)
 """
+
 from decimal import Decimal
 from pathlib import Path
 
@@ -45,10 +46,8 @@ def main() -> None:
             f.write("t,wx,wy,wz,t_phyphox\n")
             for t, wx, wy, wz, _absw in sel:
                 dt = Decimal(t) - start
-                f.write(",".join([plain(str(dt)), plain(wx), plain(wy),
-                                  plain(wz), plain(t)]) + "\n")
-        print(f"{name}: {len(sel)} samples, "
-              f"{float(Decimal(sel[-1][0]) - start):.4f} s")
+                f.write(",".join([plain(str(dt)), plain(wx), plain(wy), plain(wz), plain(t)]) + "\n")
+        print(f"{name}: {len(sel)} samples, {float(Decimal(sel[-1][0]) - start):.4f} s")
 
 
 if __name__ == "__main__":

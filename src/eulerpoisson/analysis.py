@@ -550,7 +550,9 @@ def _family_rates(a, b, y, sam):
     return nu_psi, factor, k2, den
 
 
-def spin_states_from_periods(P_psi: ArrayLike, P_phi: ArrayLike, mode: str, *, I1_I3: ArrayLike, I2_I3: ArrayLike) -> dict:
+def spin_states_from_periods(
+    P_psi: ArrayLike, P_phi: ArrayLike, mode: str, *, I1_I3: ArrayLike, I2_I3: ArrayLike
+) -> dict:
     r"""Spin states of a torque-free body with the periods :math:`P_\psi, P_\phi` in a given mode.
 
     The inverse of :func:`tumbling_periods`. A torque-free state is fixed, up
@@ -789,11 +791,24 @@ def sleeping_top(I1: float, I3: float, mass: float, ell: float, spin: float, g: 
     crit = 2.0 * np.sqrt(mass * g * ell * I1) / I3 if ell > 0 else 0.0
     if disc > 0 or (ell <= 0 and disc >= 0):
         r = np.sqrt(disc)
-        return {"stable": True, "critical_spin": crit, "omega_plus": (a + r) / (2 * I1),
-                "omega_minus": (a - r) / (2 * I1), "nutation_frequency": r / I1, "growth_rate": 0.0, "fall_angle": 0.0}
-    return {"stable": False, "critical_spin": crit, "omega_plus": np.nan, "omega_minus": np.nan,
-            "nutation_frequency": np.nan, "growth_rate": float(np.sqrt(-disc) / (2 * I1)),
-            "fall_angle": float(np.arccos(a * a / (2.0 * mass * g * ell * I1) - 1.0))}
+        return {
+            "stable": True,
+            "critical_spin": crit,
+            "omega_plus": (a + r) / (2 * I1),
+            "omega_minus": (a - r) / (2 * I1),
+            "nutation_frequency": r / I1,
+            "growth_rate": 0.0,
+            "fall_angle": 0.0,
+        }
+    return {
+        "stable": False,
+        "critical_spin": crit,
+        "omega_plus": np.nan,
+        "omega_minus": np.nan,
+        "nutation_frequency": np.nan,
+        "growth_rate": float(np.sqrt(-disc) / (2 * I1)),
+        "fall_angle": float(np.arccos(a * a / (2.0 * mass * g * ell * I1) - 1.0)),
+    }
 
 
 def gravity_gradient_frequencies(moments: ArrayLike, mean_motion: float) -> dict:

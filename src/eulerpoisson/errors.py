@@ -147,6 +147,5 @@ def require(module: str, extra: str):
         return importlib.import_module(module)
     except ImportError as exc:  # pragma: no cover - depends on environment
         raise MissingDependencyError(
-            f"{module!r} is required for this feature; install it with "
-            f"pip install 'eulerpoisson[{extra}]'"
+            f"{module!r} is required for this feature; install it with pip install 'eulerpoisson[{extra}]'"
         ) from exc

@@ -30,8 +30,18 @@ from .oracle.runs import Conventions, run_from_arrays
 __all__ = ["assert_free_motion", "reference_cases", "reference_case", "ReferenceCase", "CASE_NAMES"]
 
 
-def assert_free_motion(t: ArrayLike, q: ArrayLike, omega: ArrayLike, inertia: ArrayLike, *, atol: float, quaternion_order: str = "wxyz", omega_frame: str = "body",
-                       attitude_convention: str = "body-to-space", omega_rtol: float | None = None) -> ValidationReport:
+def assert_free_motion(
+    t: ArrayLike,
+    q: ArrayLike,
+    omega: ArrayLike,
+    inertia: ArrayLike,
+    *,
+    atol: float,
+    quaternion_order: str = "wxyz",
+    omega_frame: str = "body",
+    attitude_convention: str = "body-to-space",
+    omega_rtol: float | None = None,
+) -> ValidationReport:
     r"""Assert that sampled attitudes and rates are the exact free motion from the first sample, within ``atol``.
 
     Parameters
@@ -68,8 +78,9 @@ def assert_free_motion(t: ArrayLike, q: ArrayLike, omega: ArrayLike, inertia: Ar
         unit norm, a bad inertia or ``atol``.
     """
     raw = run_from_arrays(t, q, omega, quaternion_order=quaternion_order)
-    rep = compare_run(raw, inertia, conventions=Conventions(quaternion_order, omega_frame, attitude_convention),
-                      tolerance=atol)
+    rep = compare_run(
+        raw, inertia, conventions=Conventions(quaternion_order, omega_frame, attitude_convention), tolerance=atol
+    )
     hint = f"; {rep.convention_hint}" if rep.convention_hint else ""
     if rep.verdict == "fail":
         assert rep.exceeded_at is not None  # a failed verdict says when
@@ -77,11 +88,13 @@ def assert_free_motion(t: ArrayLike, q: ArrayLike, omega: ArrayLike, inertia: Ar
         raise AssertionError(
             f"not the exact free motion: the attitude error is {rep.attitude_error[i]:.3g} rad > atol = {atol:g} "
             f"first at t = {rep.exceeded_at:.9g} (sample {i}); largest {rep.max_attitude_error:.3g} rad at "
-            f"t = {rep.max_attitude_error_time:.9g}{hint}")
+            f"t = {rep.max_attitude_error_time:.9g}{hint}"
+        )
     if omega_rtol is not None and rep.max_omega_error > omega_rtol:
         i = int(rep.omega_error.__gt__(omega_rtol).argmax())
         raise AssertionError(
             f"not the exact free motion: the relative angular velocity error is {rep.omega_error[i]:.3g} > "
             f"omega_rtol = {omega_rtol:g} first at t = {rep.t[i]:.9g} (sample {i}); largest "
-            f"{rep.max_omega_error:.3g}{hint}")
+            f"{rep.max_omega_error:.3g}{hint}"
+        )
     return rep

@@ -152,8 +152,19 @@ class Trajectory:
     [ 0.  5. 10.]
     """
 
-    def __init__(self, t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, body: RigidBody, method: str = "", options: dict[str, Any] | None = None, stats: dict[str, Any] | None = None, *,
-                 torque: TorqueLike = None, _prepared: bool = False) -> None:
+    def __init__(
+        self,
+        t: ArrayLike,
+        quaternion: ArrayLike,
+        omega: ArrayLike,
+        body: RigidBody,
+        method: str = "",
+        options: dict[str, Any] | None = None,
+        stats: dict[str, Any] | None = None,
+        *,
+        torque: TorqueLike = None,
+        _prepared: bool = False,
+    ) -> None:
         # _prepared (private, for the solve driver): ``quaternion`` and ``omega`` are float64 arrays already
         # checked and stored by :func:`stored_attitudes` (chunk by chunk, in the threads that solved them)
         self.t = as_float_array(t, "t")
@@ -320,7 +331,9 @@ class Trajectory:
         acc.update(self.t, self.quaternion, self.omega)
         return acc.result()
 
-    def particles(self, center0: ArrayLike = (0.0, 0.0, 0.0), velocity0: ArrayLike = (0.0, 0.0, 0.0)) -> NDArray[np.float64]:
+    def particles(
+        self, center0: ArrayLike = (0.0, 0.0, 0.0), velocity0: ArrayLike = (0.0, 0.0, 0.0)
+    ) -> NDArray[np.float64]:
         r"""Positions of the body's point masses, :math:`\mathbf y_N(t) = \mathbf C_0 + \mathbf V_0 t + R(t)\mathbf x_N(0)` (paper eq. 1.2).
 
         Parameters
@@ -376,36 +389,69 @@ class Trajectory:
         T = len(self.t)
 
         def flat(a, tail):
-            return a.reshape((nb,) + a.shape[len(bshape):]) if bshape else a
+            return a.reshape((nb,) + a.shape[len(bshape) :]) if bshape else a
 
         bdim = ("body",) if bshape else ()
         inertia = np.broadcast_to(self.body.inertia, bshape + (3, 3))
         data = {
-            "quaternion": (bdim + ("time", "quat"), flat(self.quaternion, 2), {
-                "long_name": "attitude quaternion, scalar first (w, x, y, z); x_space = R(q) x_body",
-                "units": "1"}),
-            "omega": (bdim + ("time", "axis"), flat(self.omega, 2), {
-                "long_name": "body angular velocity Omega (body frame)", "units": "rad s-1"}),
-            "M": (bdim + ("time", "axis"), flat(self.M, 2), {
-                "long_name": "body angular momentum M = I Omega (body frame)", "units": "kg m2 s-1"}),
-            "m": (bdim + ("time", "axis"), flat(self.m, 2), {
-                "long_name": "spatial angular momentum m = R I Omega (space frame)", "units": "kg m2 s-1"}),
-            "energy": (bdim + ("time",), flat(self.energy, 1), {
-                "long_name": ("kinetic energy E = Omega.I Omega/2" if self.model.is_free else
-                              "energy E = Omega.I Omega/2 + U (kinetic plus the potential of the torques)"),
-                "units": "J"}),
-            "gibbs": (bdim + ("time", "axis"), flat(self.gibbs, 2), {
-                "long_name": "Gibbs rotation vector n = k tan(alpha/2) (paper eq. 1.8); NaN at alpha = pi",
-                "units": "1"}),
-            "inertia": (bdim + ("axis", "axis2"), flat(inertia, 2), {
-                "long_name": "inertia tensor in the body frame", "units": "kg m2"}),
+            "quaternion": (
+                bdim + ("time", "quat"),
+                flat(self.quaternion, 2),
+                {"long_name": "attitude quaternion, scalar first (w, x, y, z); x_space = R(q) x_body", "units": "1"},
+            ),
+            "omega": (
+                bdim + ("time", "axis"),
+                flat(self.omega, 2),
+                {"long_name": "body angular velocity Omega (body frame)", "units": "rad s-1"},
+            ),
+            "M": (
+                bdim + ("time", "axis"),
+                flat(self.M, 2),
+                {"long_name": "body angular momentum M = I Omega (body frame)", "units": "kg m2 s-1"},
+            ),
+            "m": (
+                bdim + ("time", "axis"),
+                flat(self.m, 2),
+                {"long_name": "spatial angular momentum m = R I Omega (space frame)", "units": "kg m2 s-1"},
+            ),
+            "energy": (
+                bdim + ("time",),
+                flat(self.energy, 1),
+                {
+                    "long_name": (
+                        "kinetic energy E = Omega.I Omega/2"
+                        if self.model.is_free
+                        else "energy E = Omega.I Omega/2 + U (kinetic plus the potential of the torques)"
+                    ),
+                    "units": "J",
+                },
+            ),
+            "gibbs": (
+                bdim + ("time", "axis"),
+                flat(self.gibbs, 2),
+                {
+                    "long_name": "Gibbs rotation vector n = k tan(alpha/2) (paper eq. 1.8); NaN at alpha = pi",
+                    "units": "1",
+                },
+            ),
+            "inertia": (
+                bdim + ("axis", "axis2"),
+                flat(inertia, 2),
+                {"long_name": "inertia tensor in the body frame", "units": "kg m2"},
+            ),
         }
         if self.body.positions is not None and not bshape:
             data["particle_masses"] = (("particle",), self.body.masses, {"long_name": "point masses", "units": "kg"})
-            data["particle_positions"] = (("particle", "axis"), self.body.positions, {
-                "long_name": "particle positions relative to the centre of mass at t = 0 (body frame)",
-                "units": "m"})
-            data["center_of_mass"] = (("axis",), self.body.center_of_mass, {"long_name": "centre of mass", "units": "m"})
+            data["particle_positions"] = (
+                ("particle", "axis"),
+                self.body.positions,
+                {"long_name": "particle positions relative to the centre of mass at t = 0 (body frame)", "units": "m"},
+            )
+            data["center_of_mass"] = (
+                ("axis",),
+                self.body.center_of_mass,
+                {"long_name": "centre of mass", "units": "m"},
+            )
         coords = {
             "time": ("time", self.t, {"long_name": "time", "units": "s", "standard_name": "time"}),
             "quat": ("quat", np.array(["w", "x", "y", "z"])),
@@ -413,8 +459,11 @@ class Trajectory:
             "axis2": ("axis2", np.array(["x", "y", "z"])),
         }
         attrs = {
-            "title": (f"free rigid body trajectory ({self.method})" if self.model.is_free else
-                      f"rigid body under torque: {self.model.describe()} ({self.method})"),
+            "title": (
+                f"free rigid body trajectory ({self.method})"
+                if self.model.is_free
+                else f"rigid body under torque: {self.model.describe()} ({self.method})"
+            ),
             "torque": json.dumps(_torque_records(self.model.torques)),
             "Conventions": "CF-1.10",
             "eulerpoisson_conventions": CONVENTIONS,
@@ -466,8 +515,13 @@ class Trajectory:
                     var = f.create_variable(name, dnames, dtype=h5py.string_dtype())
                     var[...] = values.astype(object)
                 else:
-                    var = f.create_variable(name, dnames, dtype=values.dtype, data=values,
-                                            fillvalue=np.nan if values.dtype.kind == "f" else None)
+                    var = f.create_variable(
+                        name,
+                        dnames,
+                        dtype=values.dtype,
+                        data=values,
+                        fillvalue=np.nan if values.dtype.kind == "f" else None,
+                    )
                 for k, val in vattrs.items():
                     var.attrs[k] = val
             for k, val in attrs.items():
@@ -539,8 +593,7 @@ class Trajectory:
         ver = format_version(path, ver)
         if ver > FORMAT_VERSION:
             raise EulerPoissonError(
-                f"{path} has format version {ver}, newer than this eulerpoisson "
-                f"({FORMAT_VERSION}); upgrade the package"
+                f"{path} has format version {ver}, newer than this eulerpoisson ({FORMAT_VERSION}); upgrade the package"
             )
         need = ["time", "inertia"]
         if "particle_masses" in ds:
@@ -566,16 +619,21 @@ class Trajectory:
         if t.ndim != 1:
             raise InvalidInputError(f"{path}: variable time must be 1-D, got shape {t.shape}")
         lead = (int(np.prod(bshape)),) if bshape else ()
-        for nm, a, tail in (("quaternion", q, (t.shape[0], 4)), ("omega", w, (t.shape[0], 3)),
-                            ("inertia", inertia, (3, 3))):
+        for nm, a, tail in (
+            ("quaternion", q, (t.shape[0], 4)),
+            ("omega", w, (t.shape[0], 3)),
+            ("inertia", inertia, (3, 3)),
+        ):
             if a.shape != lead + tail:
                 raise InvalidInputError(
                     f"{path}: variable {nm} has shape {a.shape}, expected {lead + tail} "
                     f"(batch_shape {list(bshape)}, {t.shape[0]} times)"
                 )
         if t.size > 1 and np.all(t == t[0]):
-            raise InvalidInputError(f"{path}: the time variable holds the same value {float(t[0])!r} for all "
-                                    f"{t.size} samples: the file was modified or is not ours")
+            raise InvalidInputError(
+                f"{path}: the time variable holds the same value {float(t[0])!r} for all "
+                f"{t.size} samples: the file was modified or is not ours"
+            )
         from .attitude.core import UNIT_QUATERNION_TOLERANCE
 
         with np.errstate(invalid="ignore", over="ignore"):
@@ -616,8 +674,13 @@ class Trajectory:
         # the stored M = I Omega must agree with the inertia and omega read back (an edited inertia
         # or omega would otherwise give a silently different motion)
         Mf = ds["M"].values if "M" in ds else None
-        if (Mf is not None and t.size and np.issubdtype(Mf.dtype, np.floating)
-                and Mf.shape == lead + (t.shape[0], 3) and np.all(np.isfinite(Mf))):
+        if (
+            Mf is not None
+            and t.size
+            and np.issubdtype(Mf.dtype, np.floating)
+            and Mf.shape == lead + (t.shape[0], 3)
+            and np.all(np.isfinite(Mf))
+        ):
             Mf = Mf.reshape(traj.M.shape)
             scale = np.max(np.abs(Mf), axis=(-1, -2), keepdims=True)
             err = np.max(np.abs(traj.M - Mf) / np.where(scale > 0, scale, 1.0))
@@ -668,12 +731,22 @@ class Trajectory:
             Out of range.
         """
         if isinstance(index, (tuple, float, np.floating, str)) or isinstance(index, (bool, np.bool_)):
-            raise TypeError(f"a trajectory is indexed by sample (int, slice or integer array), got {index!r}; "
-                            f"select by time with tr.sel(t=...) or evaluate with tr(t)")
+            raise TypeError(
+                f"a trajectory is indexed by sample (int, slice or integer array), got {index!r}; "
+                f"select by time with tr.sel(t=...) or evaluate with tr(t)"
+            )
         idx = np.arange(self.t.shape[0])[index]
         idx = np.atleast_1d(idx)
-        return Trajectory(self.t[idx], self.quaternion[..., idx, :], self.omega[..., idx, :], self.body,
-                          self.method, self.options, self.stats, torque=list(self.model.torques))
+        return Trajectory(
+            self.t[idx],
+            self.quaternion[..., idx, :],
+            self.omega[..., idx, :],
+            self.body,
+            self.method,
+            self.options,
+            self.stats,
+            torque=list(self.model.torques),
+        )
 
     def sel(self, t: ArrayLike, method: str | None = None) -> Trajectory:
         """The samples at the output times ``t`` (exact match, or ``method="nearest"``).
@@ -704,8 +777,10 @@ class Trajectory:
         pick = np.where(np.abs(ts[left] - want) < np.abs(ts[pos] - want), left, pos)
         if method is None and np.any(ts[pick] != want):
             bad = float(want[ts[pick] != want][0])
-            raise KeyError(f"t = {bad!r} is not an output time of this trajectory; use sel(t, method='nearest') "
-                           f"or evaluate it with tr({bad!r})")
+            raise KeyError(
+                f"t = {bad!r} is not an output time of this trajectory; use sel(t, method='nearest') "
+                f"or evaluate it with tr({bad!r})"
+            )
         return self[order[pick]]
 
     def __call__(self, t: ArrayLike, **options: Any) -> Trajectory:
@@ -740,8 +815,15 @@ class Trajectory:
         method = self.method if self.method in available_methods() else ("exact" if self.model.is_free else "taylor")
         opts = {**({} if method != self.method else self.options), **options}
         times = np.atleast_1d(as_float_array(t, "t"))
-        return solve_from(self.model, times, float(self.t[i0]), self.quaternion[..., i0, :], self.omega[..., i0, :],
-                          method=method, **opts)
+        return solve_from(
+            self.model,
+            times,
+            float(self.t[i0]),
+            self.quaternion[..., i0, :],
+            self.omega[..., i0, :],
+            method=method,
+            **opts,
+        )
 
     def plot(self, kind: str = "omega", **kwargs: Any) -> Figure:
         """A picture of the trajectory: :func:`eulerpoisson.viz.plots.plot` (``kind``: omega, invariants,
@@ -817,9 +899,7 @@ def json_attr(path, ds, key: str, default: str, kind: type):
     try:
         val = json.loads(raw)
     except (TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"{path}: attribute {key} is not valid JSON ({exc}): {str(raw)[:80]!r}"
-        ) from exc
+        raise InvalidInputError(f"{path}: attribute {key} is not valid JSON ({exc}): {str(raw)[:80]!r}") from exc
     if not isinstance(val, kind):
         raise InvalidInputError(
             f"{path}: attribute {key} must be a JSON {'list' if kind is list else 'object'}, got {raw!r}"

@@ -186,9 +186,7 @@ def skew(v: ArrayLike) -> NDArray[np.float64]:
 def _skew(v: np.ndarray) -> np.ndarray:
     x, y, z = v[..., 0], v[..., 1], v[..., 2]
     o = np.zeros_like(x)
-    return np.stack(
-        [np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2
-    )
+    return np.stack([np.stack([o, -z, y], -1), np.stack([z, o, -x], -1), np.stack([-y, x, o], -1)], -2)
 
 
 def unskew(S: ArrayLike) -> NDArray[np.float64]:
@@ -218,9 +216,7 @@ def unskew(S: ArrayLike) -> NDArray[np.float64]:
     [1. 2. 3.]
     """
     S = as_float_array(S, "S", (3, 3))
-    return 0.5 * np.stack(
-        [S[..., 2, 1] - S[..., 1, 2], S[..., 0, 2] - S[..., 2, 0], S[..., 1, 0] - S[..., 0, 1]], -1
-    )
+    return 0.5 * np.stack([S[..., 2, 1] - S[..., 1, 2], S[..., 0, 2] - S[..., 2, 0], S[..., 1, 0] - S[..., 0, 1]], -1)
 
 
 def _outer(a, b):
@@ -263,9 +259,7 @@ def as_quaternion(q, name="q") -> np.ndarray:
     q = as_float_array(q, name, (4,))
     m = np.max(np.abs(q), axis=-1)
     if np.any(m == 0):
-        raise InvalidInputError(
-            f"{name} contains a zero quaternion{_first_index(m == 0)}, which is not a rotation"
-        )
+        raise InvalidInputError(f"{name} contains a zero quaternion{_first_index(m == 0)}, which is not a rotation")
     qs = q / _pow2_below(m)[..., None]
     return qs / _norm(qs)[..., None]
 
@@ -445,9 +439,7 @@ def quaternion_make_continuous(q: ArrayLike, axis: int = 0) -> NDArray[np.float6
         raise InvalidInputError(f"axis {axis} is out of range for q of shape {q.shape}")
     ax = axis % q.ndim
     if ax == q.ndim - 1:
-        raise InvalidInputError(
-            f"axis={axis} is the quaternion axis of q (shape {q.shape}); give the series axis"
-        )
+        raise InvalidInputError(f"axis={axis} is the quaternion axis of q (shape {q.shape}); give the series axis")
     qm = np.moveaxis(q, ax, 0)
     if qm.shape[0] < 2:
         return q.copy()
@@ -780,9 +772,7 @@ def _unit_axis(axis, name="axis"):
     k = as_float_array(axis, name, (3,))
     m = np.max(np.abs(k), axis=-1)
     if np.any(m == 0):
-        raise InvalidInputError(
-            f"{name} contains a zero vector{_first_index(m == 0)}; a rotation axis must be nonzero"
-        )
+        raise InvalidInputError(f"{name} contains a zero vector{_first_index(m == 0)}; a rotation axis must be nonzero")
     k = k / _pow2_below(m)[..., None]
     return k / _norm(k)[..., None]
 
@@ -1066,9 +1056,7 @@ def parse_seq(seq):
     if any(c not in _AXES for c in s):
         raise InvalidInputError(f"seq {seq!r} may only contain the axes x, y, z")
     if s[0] == s[1] or s[1] == s[2]:
-        raise InvalidInputError(
-            f"seq {seq!r}: consecutive axes must differ (12 valid sequences, e.g. 'xyz', 'zxz')"
-        )
+        raise InvalidInputError(f"seq {seq!r}: consecutive axes must differ (12 valid sequences, e.g. 'xyz', 'zxz')")
     return [_AXES[c] for c in s], intrinsic
 
 

@@ -57,12 +57,16 @@ def _floats(text, name: str, sizes: tuple[int, ...]) -> list[float]:
         vals = []
         for p in parts:
             if not p.isascii():
-                raise UsageError(f"{name}: {p!r} is not a number written in ASCII digits (expected "
-                                 f"{' or '.join(map(str, sizes))} comma-separated numbers)")
+                raise UsageError(
+                    f"{name}: {p!r} is not a number written in ASCII digits (expected "
+                    f"{' or '.join(map(str, sizes))} comma-separated numbers)"
+                )
             try:
                 vals.append(float(p))
             except ValueError:
-                raise UsageError(f"{name}: {p!r} is not a number (expected {' or '.join(map(str, sizes))} comma-separated numbers)") from None
+                raise UsageError(
+                    f"{name}: {p!r} is not a number (expected {' or '.join(map(str, sizes))} comma-separated numbers)"
+                ) from None
     try:
         arr = np.asarray(vals, dtype=float)
     except (TypeError, ValueError):
@@ -103,8 +107,10 @@ def _load_toml(path: str) -> dict:
     except RecursionError:
         raise UsageError(f"{path}: invalid TOML: nested too deeply (a configuration has two levels)") from None
     except UnicodeDecodeError as exc:
-        raise UsageError(f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
-                         "a TOML file must be UTF-8") from None
+        raise UsageError(
+            f"{path}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
+            "a TOML file must be UTF-8"
+        ) from None
 
 
 def _option_kind(annotation) -> str:
@@ -137,13 +143,25 @@ METHOD_OPTIONS = _method_option_kinds()
 
 #: what each TOML key of ``simulate`` holds (checked when the file is read; nothing is coerced)
 _TOML_KINDS = {
-    "body": {"inertia": "inertia", "masses": "numbers", "positions": "points", "name": "str", "allow_unphysical": "bool"},
+    "body": {
+        "inertia": "inertia",
+        "masses": "numbers",
+        "positions": "points",
+        "name": "str",
+        "allow_unphysical": "bool",
+    },
     "initial": {"omega": "numbers", "m": "numbers", "quaternion": "numbers", "gibbs": "numbers"},
     "time": {"t_end": "number", "samples": "int"},
     "method": {"name": "str", **METHOD_OPTIONS},
     "output": {"file": "str", "json": "bool"},
-    "torque": {"gravity": "numbers", "mass": "number", "center_of_mass": "numbers", "gravity_gradient": "number",
-               "body_torque": "numbers", "space_torque": "numbers"},
+    "torque": {
+        "gravity": "numbers",
+        "mass": "number",
+        "center_of_mass": "numbers",
+        "gravity_gradient": "number",
+        "body_torque": "numbers",
+        "space_torque": "numbers",
+    },
     "compute": {"workers": "int"},
 }
 _TOML_KEYS = {sec: set(keys) for sec, keys in _TOML_KINDS.items()}
@@ -187,12 +205,15 @@ def _toml_value(kind: str, v, where: str):
     elif kind == "inertia":
         if isinstance(v, list) and v and all(isinstance(row, list) for row in v):
             if len(v) != 3 or not all(len(row) == 3 and all(_is_number(x) for x in row) for row in v):
-                raise UsageError(f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of "
-                                 f"numbers, got {_show(v)}")
+                raise UsageError(
+                    f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of "
+                    f"numbers, got {_show(v)}"
+                )
             return [x for row in v for x in row]
         if not isinstance(v, list) or not all(_is_number(x) for x in v):
-            raise UsageError(f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of "
-                             f"numbers, got {_show(v)}")
+            raise UsageError(
+                f"{where} must be 3 numbers (principal moments), 9 numbers or a 3x3 table of numbers, got {_show(v)}"
+            )
     else:  # pragma: no cover - table above is closed
         raise AssertionError(kind)
     return v
@@ -289,8 +310,11 @@ def _naming_target(target):
         for f in (exc.filename, exc.filename2):
             if isinstance(f, (str, bytes)) and helper(f):
                 reason = exc.strerror or _message(exc)
-                raise (OSError(exc.errno, f"cannot write {target}: {reason}") if exc.errno is not None
-                       else OSError(f"cannot write {target}: {reason}")) from exc
+                raise (
+                    OSError(exc.errno, f"cannot write {target}: {reason}")
+                    if exc.errno is not None
+                    else OSError(f"cannot write {target}: {reason}")
+                ) from exc
         raise
 
 
@@ -308,13 +332,17 @@ def _build_body(cfg, name=None):
         masses, positions = cfg["body.masses"], cfg["body.positions"]
         if len(masses) != len(positions):
             pre, a, b = _pair(name, "body.masses", "body.positions")
-            raise UsageError(f"{pre}{a} has {len(masses)} entries but {b} has {len(positions)} points; "
-                             "give one mass per point")
+            raise UsageError(
+                f"{pre}{a} has {len(masses)} entries but {b} has {len(positions)} points; give one mass per point"
+            )
         return RigidBody.from_particles(masses, positions, name=label)
     if "body.inertia" not in cfg:
         raise UsageError("no body given: use --inertia I1,I2,I3 (or nine numbers) or a TOML file with [body]")
-    return RigidBody(inertia_from(cfg["body.inertia"], name("body.inertia")), name=label,
-                     allow_unphysical=bool(cfg.get("body.allow_unphysical", False)))
+    return RigidBody(
+        inertia_from(cfg["body.inertia"], name("body.inertia")),
+        name=label,
+        allow_unphysical=bool(cfg.get("body.allow_unphysical", False)),
+    )
 
 
 def _number(value, name: str, *, positive: bool = False) -> float:
@@ -341,15 +369,20 @@ def _build_torques(cfg, name=None) -> list:
     if "torque.center_of_mass" in cfg:
         com = _floats(cfg["torque.center_of_mass"], name("torque.center_of_mass"), (3,))
         mass = _number(cfg["torque.mass"], name("torque.mass"), positive=True) if "torque.mass" in cfg else 1.0
-        g = (_floats(cfg["torque.gravity"], name("torque.gravity"), (3,)) if "torque.gravity" in cfg
-             else [0.0, 0.0, -STANDARD_GRAVITY])
+        g = (
+            _floats(cfg["torque.gravity"], name("torque.gravity"), (3,))
+            if "torque.gravity" in cfg
+            else [0.0, 0.0, -STANDARD_GRAVITY]
+        )
         torques.append(Gravity(mass, com, g))
     else:
         for key in ("torque.mass", "torque.gravity"):
             if key in cfg:
-                raise UsageError(f"{name(key)} needs the centre of mass of the heavy top: "
-                                 f"{_FLAGS['torque.center_of_mass']} CX,CY,CZ (body frame, from the fixed point) "
-                                 "or [torque] center_of_mass")
+                raise UsageError(
+                    f"{name(key)} needs the centre of mass of the heavy top: "
+                    f"{_FLAGS['torque.center_of_mass']} CX,CY,CZ (body frame, from the fixed point) "
+                    "or [torque] center_of_mass"
+                )
     if "torque.gravity_gradient" in cfg:
         torques.append(GravityGradient(_number(cfg["torque.gravity_gradient"], name("torque.gravity_gradient"))))
     if "torque.body_torque" in cfg:
@@ -500,8 +533,9 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: boo
                 tr = solve(model, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
             else:
                 # the time-dependent torques are shifted to the chunk's start (solve_from)
-                tr = solve_from(model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :],
-                                method=method, **opts)
+                tr = solve_from(
+                    model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :], method=method, **opts
+                )
             first = tr if first is None else first
             if acc is not None:
                 acc.update(tr.t, tr.quaternion, tr.omega)
@@ -517,12 +551,27 @@ def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: boo
     assert first is not None  # there is at least one piece
     stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
     if acc is not None:
-        ends = Trajectory(t[[0, -1]], np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
-                          np.concatenate([ws[0][..., :1, :], ws[-1][..., -1:, :]], axis=-2), first.body, method,
-                          first.options, stats, torque=list(model.torques))
+        ends = Trajectory(
+            t[[0, -1]],
+            np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
+            np.concatenate([ws[0][..., :1, :], ws[-1][..., -1:, :]], axis=-2),
+            first.body,
+            method,
+            first.options,
+            stats,
+            torque=list(model.torques),
+        )
         return ends, acc.result()
-    return Trajectory(t, np.concatenate(qs, axis=-2), np.concatenate(ws, axis=-2), first.body, method, first.options, stats,
-                      torque=list(model.torques))
+    return Trajectory(
+        t,
+        np.concatenate(qs, axis=-2),
+        np.concatenate(ws, axis=-2),
+        first.body,
+        method,
+        first.options,
+        stats,
+        torque=list(model.torques),
+    )
 
 
 def cmd_simulate(args) -> int:
@@ -537,24 +586,44 @@ def cmd_simulate(args) -> int:
         cfg.update(_config_from_toml(_load_toml(args.config), args.config, src))
         # a file that contradicts itself is an error even when a flag would replace both values
         file_name = _namer(src)
-        for k1, k2, what in (("initial.omega", "initial.m", "exactly one of"),
-                             ("initial.quaternion", "initial.gibbs", "at most one of"),
-                             ("body.inertia", "body.masses", "either"), ("body.inertia", "body.positions", "either")):
+        for k1, k2, what in (
+            ("initial.omega", "initial.m", "exactly one of"),
+            ("initial.quaternion", "initial.gibbs", "at most one of"),
+            ("body.inertia", "body.masses", "either"),
+            ("body.inertia", "body.positions", "either"),
+        ):
             if k1 in cfg and k2 in cfg:
                 pre, a, b = _pair(file_name, k1, k2)
                 raise UsageError(f"{pre}give {what} {a} {'or' if what == 'either' else 'and'} {b}, not both")
-    given = {key: getattr(args, attr) for attr, key in (
-        ("inertia", "body.inertia"), ("omega", "initial.omega"), ("m", "initial.m"),
-        ("quaternion", "initial.quaternion"), ("gibbs", "initial.gibbs"), ("t_end", "time.t_end"),
-        ("samples", "time.samples"), ("method", "method.name"), ("allow_unphysical", "body.allow_unphysical"),
-        *((opt, f"method.{opt}") for opt in METHOD_OPTIONS), ("out", "output.file"),
-        ("gravity", "torque.gravity"), ("mass", "torque.mass"), ("com", "torque.center_of_mass"),
-        ("gravity_gradient", "torque.gravity_gradient"), ("body_torque", "torque.body_torque"),
-        ("space_torque", "torque.space_torque"), ("workers", "compute.workers"),
-    ) if getattr(args, attr, None) is not None}
+    given = {
+        key: getattr(args, attr)
+        for attr, key in (
+            ("inertia", "body.inertia"),
+            ("omega", "initial.omega"),
+            ("m", "initial.m"),
+            ("quaternion", "initial.quaternion"),
+            ("gibbs", "initial.gibbs"),
+            ("t_end", "time.t_end"),
+            ("samples", "time.samples"),
+            ("method", "method.name"),
+            ("allow_unphysical", "body.allow_unphysical"),
+            *((opt, f"method.{opt}") for opt in METHOD_OPTIONS),
+            ("out", "output.file"),
+            ("gravity", "torque.gravity"),
+            ("mass", "torque.mass"),
+            ("com", "torque.center_of_mass"),
+            ("gravity_gradient", "torque.gravity_gradient"),
+            ("body_torque", "torque.body_torque"),
+            ("space_torque", "torque.space_torque"),
+            ("workers", "compute.workers"),
+        )
+        if getattr(args, attr, None) is not None
+    }
     # two flags that say the same thing differently are an error; a flag replaces what the file says
     if "initial.omega" in given and "initial.m" in given:
-        raise UsageError("give exactly one of --omega and --m (the initial body angular velocity or the angular momentum), not both")
+        raise UsageError(
+            "give exactly one of --omega and --m (the initial body angular velocity or the angular momentum), not both"
+        )
     if "initial.quaternion" in given and "initial.gibbs" in given:
         raise UsageError("give at most one of --quaternion and --gibbs (the initial attitude), not both")
     replaces = {
@@ -577,7 +646,9 @@ def cmd_simulate(args) -> int:
         pre, a, b = _pair(name, "initial.omega", "initial.m")
         raise UsageError(f"{pre}give exactly one of {a} and {b}, not both")
     if "initial.omega" not in cfg and "initial.m" not in cfg:
-        raise UsageError("give exactly one initial condition: --omega W1,W2,W3 (body angular velocity) or --m (angular momentum)")
+        raise UsageError(
+            "give exactly one initial condition: --omega W1,W2,W3 (body angular velocity) or --m (angular momentum)"
+        )
     omega0 = m0 = None
     if "initial.omega" in cfg:
         omega0 = _floats(cfg["initial.omega"], name("initial.omega"), (3,))
@@ -604,8 +675,9 @@ def cmd_simulate(args) -> int:
     except (TypeError, ValueError):
         raise UsageError(f"{name('time.t_end')}: {cfg['time.t_end']!r} is not a number") from None
     if not math.isfinite(t_end):
-        raise UsageError(f"{name('time.t_end')} must be a finite number (negative: backwards in time), "
-                         f"got {cfg['time.t_end']!r}")
+        raise UsageError(
+            f"{name('time.t_end')} must be a finite number (negative: backwards in time), got {cfg['time.t_end']!r}"
+        )
     samples = cfg.get("time.samples", 1001)
     if isinstance(samples, str):
         try:
@@ -615,8 +687,10 @@ def cmd_simulate(args) -> int:
     if samples < 2:
         raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples}")
     if samples > MAX_SAMPLES:
-        raise UsageError(f"{name('time.samples')} = {samples} is more than {MAX_SAMPLES:.3g} output times, which no "
-                         f"file or memory holds (a .zarr store of 1e8 samples is about 11 GB)")
+        raise UsageError(
+            f"{name('time.samples')} = {samples} is more than {MAX_SAMPLES:.3g} output times, which no "
+            f"file or memory holds (a .zarr store of 1e8 samples is about 11 GB)"
+        )
     out_name = cfg.get("output.file")
     if not (isinstance(out_name, str) and out_name.endswith(".zarr")):
         # a run written to NetCDF is held in memory; one written nowhere keeps its ends and the times only
@@ -632,7 +706,9 @@ def cmd_simulate(args) -> int:
     # the closed form runs the free body (and the Lagrange top); under a torque the default is taylor
     method = cfg.get("method.name", "exact" if model.is_free else "taylor")
     if method not in available_methods():
-        raise UsageError(f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}")
+        raise UsageError(
+            f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}"
+        )
     check_supported(method, model)  # UnsupportedModelError (one line, exit 2) names the methods that can
     opts = _method_options(cfg, name, method)
     workers = cfg.get("compute.workers")
@@ -642,8 +718,9 @@ def cmd_simulate(args) -> int:
         except ValueError:
             workers = 0
         if workers < 1:
-            raise UsageError(f"{name('compute.workers')} must be a whole number of threads >= 1, "
-                             f"got {cfg['compute.workers']!r}")
+            raise UsageError(
+                f"{name('compute.workers')} must be a whole number of threads >= 1, got {cfg['compute.workers']!r}"
+            )
         opts["workers"] = workers  # a keyword of solve, solve_from and solve_to_file, not a method option
     out = cfg.get("output.file")
     check_file_name(out, name("output.file"))
@@ -656,27 +733,47 @@ def cmd_simulate(args) -> int:
         from ..io.outputs import OutputLock, check_output
 
         zarr_out = str(out).endswith(".zarr")
-        check_output(out, "trajectory-store" if zarr_out else "netcdf", overwrite=bool(args.overwrite),
-                     inputs=[args.config])
+        check_output(
+            out, "trajectory-store" if zarr_out else "netcdf", overwrite=bool(args.overwrite), inputs=[args.config]
+        )
     if out is not None and str(out).endswith(".zarr"):
         # long runs stream to disk chunk by chunk (atomic, resumable); the state at T is read back from the file
         from ..io.stream import partial_store, solve_to_file
 
         if partial_store(out).exists() and not args.overwrite and not args.quiet and not as_json:
-            print(f"resuming the interrupted run to {out} from its finished chunks (--overwrite starts afresh)",
-                  file=sys.stderr)
+            print(
+                f"resuming the interrupted run to {out} from its finished chunks (--overwrite starts afresh)",
+                file=sys.stderr,
+            )
         start = time.perf_counter()
         with OutputLock(out), _naming_target(out):
             try:
-                solve_to_file(model, (0.0, t_end, samples), out, omega0=omega0, m0=m0, attitude0=q0, method=method,
-                              progress=progress, resume=not args.overwrite, overwrite=bool(args.overwrite), **opts)
+                solve_to_file(
+                    model,
+                    (0.0, t_end, samples),
+                    out,
+                    omega0=omega0,
+                    m0=m0,
+                    attitude0=q0,
+                    method=method,
+                    progress=progress,
+                    resume=not args.overwrite,
+                    overwrite=bool(args.overwrite),
+                    **opts,
+                )
             except KeyboardInterrupt:
-                print(f"eulerpoisson: interrupted; the finished chunks of {out} are kept: run the same command "
-                      f"again to resume", file=sys.stderr)
+                print(
+                    f"eulerpoisson: interrupted; the finished chunks of {out} are kept: run the same command "
+                    f"again to resume",
+                    file=sys.stderr,
+                )
                 raise
             except EulerPoissonError as exc:
-                raise type(exc)(str(exc).replace("pass overwrite=True", "run again with --overwrite")
-                                .replace("overwrite=True", "--overwrite")) from exc
+                raise type(exc)(
+                    str(exc)
+                    .replace("pass overwrite=True", "run again with --overwrite")
+                    .replace("overwrite=True", "--overwrite")
+                ) from exc
         from ..trajectory import Trajectory
 
         store = Trajectory.open(out)  # lazy: only the two samples below are read
@@ -742,8 +839,10 @@ def _read_traj(path):
     if not os.path.exists(path):
         raise UsageError(f"{path}: no such file (write one with 'eulerpoisson simulate ... --out {path}')")
     if os.path.isdir(path) and file_format(path) != "zarr":
-        raise UsageError(f"{path} is a directory, not a trajectory file (a NetCDF file or a .zarr store, written by "
-                         "'eulerpoisson simulate --out')")
+        raise UsageError(
+            f"{path} is a directory, not a trajectory file (a NetCDF file or a .zarr store, written by "
+            "'eulerpoisson simulate --out')"
+        )
     try:
         return Trajectory.open(path)
     except MissingDependencyError:
@@ -766,8 +865,10 @@ def cmd_plot(args) -> int:
         if not os.path.exists(args.file):
             raise UsageError(f"{args.file}: no such sweep store (make one with 'eulerpoisson sweep sweep.toml')")
         if file_kind(args.file) != "sweep-store":
-            raise UsageError(f"{args.file}: --kind atlas draws a sweep store (made by 'eulerpoisson sweep'), and this "
-                             f"is not one; a trajectory has the kinds omega, invariants, polhode, gibbs, attitude, apex")
+            raise UsageError(
+                f"{args.file}: --kind atlas draws a sweep store (made by 'eulerpoisson sweep'), and this "
+                f"is not one; a trajectory has the kinds omega, invariants, polhode, gibbs, attitude, apex"
+            )
         plot_atlas(load_sweep(args.file), out)
     else:
         from ..viz import plots
@@ -796,10 +897,14 @@ def cmd_animate(args) -> int:
     check_file_name(args.out, "--out")
     ext = Path(args.out).suffix.lower().lstrip(".")
     if ext not in FORMATS and ext != "htm":
-        raise UsageError(f"--out {args.out!r}: unsupported file extension; use .html (self-contained page), .gif or .mp4")
+        raise UsageError(
+            f"--out {args.out!r}: unsupported file extension; use .html (self-contained page), .gif or .mp4"
+        )
     video = ext in ("gif", "mp4")
     if args.fps is not None and not video:
-        raise UsageError("--fps applies to .gif and .mp4 movies only (an HTML page animates at the browser's frame rate)")
+        raise UsageError(
+            "--fps applies to .gif and .mp4 movies only (an HTML page animates at the browser's frame rate)"
+        )
     fps = _fps(args.fps) if args.fps is not None else 30
     traj = _read_traj(args.file)
     if video:
@@ -831,7 +936,9 @@ def _info_store(args, traj) -> int:
     ]
     if len(traj) == 0:
         lines.append("  samples     0 (no output times)")
-        lines.append(f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}")
+        lines.append(
+            f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}"
+        )
         print("\n".join(lines))
         return 0
     first, last = traj.head(), traj.tail()
@@ -841,12 +948,16 @@ def _info_store(args, traj) -> int:
         lines.append(f"  bodies      batch of shape {traj.batch_shape}")
     else:
         lines.append(f"  body        {b!r}")
-        lines.append(f"  energy      {float(first.energy[0]):.15g}"
-                     + ("" if traj.model.is_free else " (kinetic + potential)"))
+        lines.append(
+            f"  energy      {float(first.energy[0]):.15g}" + ("" if traj.model.is_free else " (kinetic + potential)")
+        )
         lines.append(f"  m           {np.round(first.m[0], 12).tolist()}")
     drift = traj.drift_endpoints()
-    lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in drift.items())
-                 + " (last sample against the first)")
+    lines.append(
+        "  drift       "
+        + ", ".join(f"{k} {np.max(v):.2e}" for k, v in drift.items())
+        + " (last sample against the first)"
+    )
     print("\n".join(lines))
     return 0
 
@@ -866,7 +977,7 @@ def _partial_run_of(path) -> tuple[Path, Path, bool] | None:
         return None
     for work in ((p.parent,) if p.name == "store.zarr" else ()) + (p,):
         if work.name.startswith(".") and work.name.endswith(".partial") and len(work.name) > 9 and work.is_dir():
-            return work.with_name(work.name[1:-len(".partial")]), work, True
+            return work.with_name(work.name[1 : -len(".partial")]), work, True
     work = p.with_name(f".{p.name}.partial")
     return (p, work, False) if work.is_dir() else None
 
@@ -892,8 +1003,20 @@ def _resume_command(target: str, fp: dict) -> str | None:
     from ..model.equations import Model
     from ..solvers import get_method, make_problem
 
-    known = {"version", "method", "options", "inertia", "positions", "q0", "omega0", "times", "chunk", "n",
-             "variables", "torque"}
+    known = {
+        "version",
+        "method",
+        "options",
+        "inertia",
+        "positions",
+        "q0",
+        "omega0",
+        "times",
+        "chunk",
+        "n",
+        "variables",
+        "torque",
+    }
     try:
         chunk = inspect.signature(solve_to_file).parameters["chunk"].default
         if set(fp) - known or fp.get("positions") is not None or fp["chunk"] != chunk:
@@ -920,10 +1043,12 @@ def _resume_command(target: str, fp: dict) -> str | None:
             cfg["initial.quaternion"] = ",".join(_num(v) for v in fp["q0"])
             flags += ["--quaternion", cfg["initial.quaternion"]]
         flags += ["--t-end", _num(t_end), "--samples", str(int(samples))]
-        keys = {"gravity": (("torque.center_of_mass", "center_of_mass"), ("torque.mass", "mass"),
-                            ("torque.gravity", "g")),
-                "gravity_gradient": (("torque.gravity_gradient", "mean_motion"),),
-                "body_torque": (("torque.body_torque", "tau"),), "space_torque": (("torque.space_torque", "tau"),)}
+        keys = {
+            "gravity": (("torque.center_of_mass", "center_of_mass"), ("torque.mass", "mass"), ("torque.gravity", "g")),
+            "gravity_gradient": (("torque.gravity_gradient", "mean_motion"),),
+            "body_torque": (("torque.body_torque", "tau"),),
+            "space_torque": (("torque.space_torque", "tau"),),
+        }
         for rec in fp.get("torque", []):
             for key, field in keys[rec["kind"]]:
                 v = rec[field]
@@ -949,13 +1074,22 @@ def _resume_command(target: str, fp: dict) -> str | None:
         if "initial.quaternion" in cfg:  # as simulate does: normalized
             q0 = np.array(_floats(cfg["initial.quaternion"], "--quaternion", (4,)))
             q0 = q0 / float(np.linalg.norm(q0))
-        problem = make_problem(model, np.array([0.0]), omega0=_floats(cfg["initial.omega"], "--omega", (3,)),
-                               attitude0=q0)
-        mine = {"version": fp["version"], "method": method, "options": config(_method_options(cfg, None, method)),
-                "inertia": np.asarray(problem.body.inertia).tolist(), "positions": None,
-                "q0": problem.q0.tolist(), "omega0": problem.omega0.tolist(),
-                "times": {"grid": [0.0, float(_num(t_end)), int(samples)]}, "chunk": chunk, "n": int(samples),
-                "variables": list(TIME_VARIABLES)}
+        problem = make_problem(
+            model, np.array([0.0]), omega0=_floats(cfg["initial.omega"], "--omega", (3,)), attitude0=q0
+        )
+        mine = {
+            "version": fp["version"],
+            "method": method,
+            "options": config(_method_options(cfg, None, method)),
+            "inertia": np.asarray(problem.body.inertia).tolist(),
+            "positions": None,
+            "q0": problem.q0.tolist(),
+            "omega0": problem.omega0.tolist(),
+            "times": {"grid": [0.0, float(_num(t_end)), int(samples)]},
+            "chunk": chunk,
+            "n": int(samples),
+            "variables": list(TIME_VARIABLES),
+        }
         if not model.is_free:
             mine["torque"] = torque_fingerprint(model)
         if json.loads(json.dumps(mine, default=float, sort_keys=True)) != fp:
@@ -976,22 +1110,29 @@ def _info_partial(args, target: Path, work: Path) -> int:
         with open(work / "state.json", encoding="utf-8") as fh:
             fp = json.load(fh)
     except (OSError, ValueError):
-        print(f"{args.file}: an unfinished run to {target} that stopped before its first chunk (while its store "
-              f"was being created): nothing was computed; the next run to {target} starts afresh")
+        print(
+            f"{args.file}: an unfinished run to {target} that stopped before its first chunk (while its store "
+            f"was being created): nothing was computed; the next run to {target} starts afresh"
+        )
         return 0
     try:
         n, chunk = int(fp["n"]), int(fp["chunk"])
         fp["times"]["grid" if "grid" in fp["times"] else "array"]
     except (TypeError, KeyError):  # not a trajectory stream: a sweep (or a newer format)
         finished = [f for f in (work / "done").iterdir() if f.name.isdigit()] if (work / "done").is_dir() else []
-        print(f"{args.file}: an unfinished sweep (or another unfinished result) to {target}, not a trajectory: "
-              f"{len(finished)} chunk(s) finished; run the command that wrote it again to resume it "
-              f"('eulerpoisson sweep CONFIG --out {target}')")
+        print(
+            f"{args.file}: an unfinished sweep (or another unfinished result) to {target}, not a trajectory: "
+            f"{len(finished)} chunk(s) finished; run the command that wrote it again to resume it "
+            f"('eulerpoisson sweep CONFIG --out {target}')"
+        )
         return 0
     nchunks = max(1, -(-n // chunk))
     done_dir = work / "done"
-    done = sorted(k for k in (int(f.name) for f in done_dir.iterdir() if f.name.isdigit()) if k < nchunks) \
-        if done_dir.is_dir() else []
+    done = (
+        sorted(k for k in (int(f.name) for f in done_dir.iterdir() if f.name.isdigit()) if k < nchunks)
+        if done_dir.is_dir()
+        else []
+    )
     samples_done = sum(min(chunk, n - k * chunk) for k in done)
     prefix = 0
     while prefix < len(done) and done[prefix] == prefix:
@@ -1004,15 +1145,18 @@ def _info_partial(args, target: Path, work: Path) -> int:
         pass
     running = bool(pid) and pid != os.getpid() and pid_alive(pid)
     state = f"being written now (process {pid})" if running else "interrupted"
-    lines = [f"{args.file}: unfinished run to {target} ({state}): {len(done)} of {nchunks} chunks finished, "
-             f"{samples_done} of {n} samples ({100.0 * samples_done / n:.3g}%)" if n else
-             f"{args.file}: unfinished run to {target} ({state}): no output times"]
+    lines = [
+        f"{args.file}: unfinished run to {target} ({state}): {len(done)} of {nchunks} chunks finished, "
+        f"{samples_done} of {n} samples ({100.0 * samples_done / n:.3g}%)"
+        if n
+        else f"{args.file}: unfinished run to {target} ({state}): no output times"
+    ]
 
     def times(idx):
         grid = fp.get("times", {}).get("grid")
         if grid is not None:
             g = TimeGrid(float(grid[0]), float(grid[1]), int(grid[2]))
-            return [float(g[i:i + 1][0]) for i in idx]
+            return [float(g[i : i + 1][0]) for i in idx]
         from ..io.read import zarr_group
 
         tarr = zarr_group(work / "store.zarr")["time"]
@@ -1022,11 +1166,15 @@ def _info_partial(args, target: Path, work: Path) -> int:
         if prefix:
             last = min(n, prefix * chunk) - 1
             ta, tb = times([0, last])
-            lines.append(f"  finished    samples 0 to {last}: t from {ta:.6g} to {tb:.6g}"
-                         + (f" (and {len(done) - prefix} chunk(s) further on)" if len(done) > prefix else ""))
+            lines.append(
+                f"  finished    samples 0 to {last}: t from {ta:.6g} to {tb:.6g}"
+                + (f" (and {len(done) - prefix} chunk(s) further on)" if len(done) > prefix else "")
+            )
         elif done:
-            lines.append(f"  finished    chunk(s) {', '.join(map(str, done[:8]))}{' ...' if len(done) > 8 else ''}"
-                         f" ({chunk} samples each)")
+            lines.append(
+                f"  finished    chunk(s) {', '.join(map(str, done[:8]))}{' ...' if len(done) > 8 else ''}"
+                f" ({chunk} samples each)"
+            )
         else:
             lines.append("  finished    nothing yet")
         if n:
@@ -1040,22 +1188,30 @@ def _info_partial(args, target: Path, work: Path) -> int:
         from ..model.equations import Model
         from ..model.torques import torque_from_dict
 
-        body = RigidBody(np.array(fp["inertia"], dtype=float), allow_unphysical=True) \
-            if fp.get("positions") is None else None
+        body = (
+            RigidBody(np.array(fp["inertia"], dtype=float), allow_unphysical=True)
+            if fp.get("positions") is None
+            else None
+        )
         if body is not None:
             lines.append(f"  body        {body!r}")
             lines.append(f"  torque      {Model(body, [torque_from_dict(r) for r in fp.get('torque', [])]).describe()}")
     except Exception:  # noqa: BLE001
         pass
-    lines.append(f"  store       {work / 'store.zarr'}: the finished chunks (xarray.open_zarr reads it; unfinished "
-                 "samples are NaN)")
+    lines.append(
+        f"  store       {work / 'store.zarr'}: the finished chunks (xarray.open_zarr reads it; unfinished "
+        "samples are NaN)"
+    )
     if running:
         lines.append("  resume      not now: wait for the running process to finish (or stop it with Ctrl-C)")
     else:
         cmd = _resume_command(str(target), fp)
-        lines.append(f"  resume      {cmd}" if cmd else
-                     f"  resume      run the command that wrote it again ('eulerpoisson simulate ... --out {target}', "
-                     "or solve_to_file(..., resume=True) with the same arguments)")
+        lines.append(
+            f"  resume      {cmd}"
+            if cmd
+            else f"  resume      run the command that wrote it again ('eulerpoisson simulate ... --out {target}', "
+            "or solve_to_file(..., resume=True) with the same arguments)"
+        )
     print("\n".join(lines))
     return 0
 
@@ -1067,8 +1223,10 @@ def cmd_info(args) -> int:
         return _info_partial(args, partial[0], partial[1])
     traj = _read_traj(args.file)
     if partial is not None:  # a finished file, and an unfinished run to replace it (simulate --overwrite)
-        print(f"{args.file}: note: an unfinished run to replace it is kept in {partial[1]} "
-              f"('eulerpoisson info {partial[1] / 'store.zarr'}' says how far it got)")
+        print(
+            f"{args.file}: note: an unfinished run to replace it is kept in {partial[1]} "
+            f"('eulerpoisson info {partial[1] / 'store.zarr'}' says how far it got)"
+        )
     if getattr(traj, "lazy", False):
         return _info_store(args, traj)
     b = traj.body
@@ -1079,7 +1237,9 @@ def cmd_info(args) -> int:
     ]
     if len(traj.t) == 0:  # a valid file with no output times: nothing to measure
         lines.append("  samples     0 (no output times)")
-        lines.append(f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}")
+        lines.append(
+            f"  body        {b!r}" if not traj.batch_shape else f"  bodies      batch of shape {traj.batch_shape}"
+        )
         print("\n".join(lines))
         return 0
     lines.append(f"  samples     {len(traj.t)}, t from {traj.t.min():.6g} to {traj.t.max():.6g}")
@@ -1087,8 +1247,9 @@ def cmd_info(args) -> int:
         lines.append(f"  bodies      batch of shape {traj.batch_shape}")
     else:
         lines.append(f"  body        {b!r}")
-        lines.append(f"  energy      {float(traj.energy[0]):.15g}"
-                     + ("" if traj.model.is_free else " (kinetic + potential)"))
+        lines.append(
+            f"  energy      {float(traj.energy[0]):.15g}" + ("" if traj.model.is_free else " (kinetic + potential)")
+        )
         lines.append(f"  m           {np.round(traj.m[0], 12).tolist()}")
     lines.append("  drift       " + ", ".join(f"{k} {np.max(v):.2e}" for k, v in traj.drift().items()))
     print("\n".join(lines))
@@ -1107,8 +1268,10 @@ def cmd_sweep(args) -> int:
     try:
         cfg = load_config(args.config)
     except UnicodeDecodeError as exc:
-        raise UsageError(f"{args.config}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
-                         "a TOML file must be UTF-8") from None
+        raise UsageError(
+            f"{args.config}: not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at position {exc.start}); "
+            "a TOML file must be UTF-8"
+        ) from None
     from ..io.outputs import OutputLock, check_output
 
     target = args.out if args.out is not None else cfg.path
@@ -1127,8 +1290,11 @@ def cmd_sweep(args) -> int:
         # the library speaks of its keyword argument; on the command line it is a flag
         msg = str(exc)
         if "overwrite=True" in msg:
-            raise EulerPoissonError(msg.replace("pass overwrite=True", "run again with --overwrite")
-                                    .replace("overwrite=True", "--overwrite")) from exc
+            raise EulerPoissonError(
+                msg.replace("pass overwrite=True", "run again with --overwrite").replace(
+                    "overwrite=True", "--overwrite"
+                )
+            ) from exc
         raise
     if not args.quiet:
         print(f"wrote {path}")
@@ -1154,8 +1320,11 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="Run 'eulerpoisson COMMAND --help' for a command's options and examples.",
     )
     p.add_argument("--version", action="version", version=f"eulerpoisson {__version__}")
-    p.add_argument("--debug", action="store_true",
-                   help="show tracebacks and warnings instead of one-line errors (accepted anywhere on the line)")
+    p.add_argument(
+        "--debug",
+        action="store_true",
+        help="show tracebacks and warnings instead of one-line errors (accepted anywhere on the line)",
+    )
     sub = p.add_subparsers(dest="command", parser_class=_Parser, metavar="COMMAND")
 
     ex = argparse.RawDescriptionHelpFormatter
@@ -1192,32 +1361,61 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--quaternion", help="initial attitude w,x,y,z (unit, scalar first); default identity")
     s.add_argument("--gibbs", help="initial attitude as the Gibbs vector n1,n2,n3")
     s.add_argument("--t-end", dest="t_end", help="final time T (negative: the motion backwards from t = 0)")
-    s.add_argument("--allow-unphysical", dest="allow_unphysical", action="store_true", default=None,
-                   help="accept moments that violate the triangle inequality (e.g. 3,5,9: no mass distribution has them)")
+    s.add_argument(
+        "--allow-unphysical",
+        dest="allow_unphysical",
+        action="store_true",
+        default=None,
+        help="accept moments that violate the triangle inequality (e.g. 3,5,9: no mass distribution has them)",
+    )
     s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
-    s.add_argument("--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)")
+    s.add_argument(
+        "--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)"
+    )
     for opt in METHOD_OPTIONS:  # every option of every method, read from the option dataclasses
-        owners = "; ".join(f"{m}: default {get_method(m).options[opt]}" for m in available_methods()
-                           if opt in get_method(m).options)
-        s.add_argument("--" + opt.replace("_", "-"), dest=opt, metavar=opt.upper(),
-                       help=f"method option {opt} ({owners})")
-    s.add_argument("--com", metavar="CX,CY,CZ",
-                   help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)")
+        owners = "; ".join(
+            f"{m}: default {get_method(m).options[opt]}" for m in available_methods() if opt in get_method(m).options
+        )
+        s.add_argument(
+            "--" + opt.replace("_", "-"), dest=opt, metavar=opt.upper(), help=f"method option {opt} ({owners})"
+        )
+    s.add_argument(
+        "--com",
+        metavar="CX,CY,CZ",
+        help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)",
+    )
     s.add_argument("--mass", metavar="M", help="heavy top: mass M > 0 (default 1; needs --com)")
-    s.add_argument("--gravity", metavar="GX,GY,GZ",
-                   help="heavy top: gravitational acceleration, space frame (default 0,0,-9.81; needs --com)")
-    s.add_argument("--gravity-gradient", dest="gravity_gradient", metavar="NU",
-                   help="gravity-gradient torque of a circular orbit with mean motion NU >= 0 (rad per time unit)")
+    s.add_argument(
+        "--gravity",
+        metavar="GX,GY,GZ",
+        help="heavy top: gravitational acceleration, space frame (default 0,0,-9.81; needs --com)",
+    )
+    s.add_argument(
+        "--gravity-gradient",
+        dest="gravity_gradient",
+        metavar="NU",
+        help="gravity-gradient torque of a circular orbit with mean motion NU >= 0 (rad per time unit)",
+    )
     s.add_argument("--body-torque", dest="body_torque", metavar="TX,TY,TZ", help="constant torque in the body frame")
     s.add_argument("--space-torque", dest="space_torque", metavar="TX,TY,TZ", help="constant torque in the space frame")
     s.add_argument("--out", help="write the trajectory to this NetCDF (.nc) file or stream it to a Zarr (.zarr) store")
-    s.add_argument("--json", action="store_true",
-                   help="print the state at T, the torques, the integrals at T and their drift as one JSON object")
-    s.add_argument("--overwrite", action="store_true",
-                   help="replace an existing output of the same kind (an interrupted .zarr run resumes without it)")
-    s.add_argument("-j", "--workers", metavar="N",
-                   help="threads that solve a batch of bodies (default: $EULERPOISSON_WORKERS, else every core; "
-                        "1: one thread); the results do not depend on it")
+    s.add_argument(
+        "--json",
+        action="store_true",
+        help="print the state at T, the torques, the integrals at T and their drift as one JSON object",
+    )
+    s.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an existing output of the same kind (an interrupted .zarr run resumes without it)",
+    )
+    s.add_argument(
+        "-j",
+        "--workers",
+        metavar="N",
+        help="threads that solve a batch of bodies (default: $EULERPOISSON_WORKERS, else every core; "
+        "1: one thread); the results do not depend on it",
+    )
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=cmd_simulate)
 
@@ -1229,7 +1427,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     a.add_argument("--format", choices=["md", "json", "tex"], default="md", help="report format (default md)")
     a.add_argument("--out", help="write the report to this file instead of printing it")
-    a.add_argument("--overwrite", action="store_true", help="replace an existing report file (never a file of another kind)")
+    a.add_argument(
+        "--overwrite", action="store_true", help="replace an existing report file (never a file of another kind)"
+    )
     a.add_argument("--quiet", action="store_true")
     a.set_defaults(func=cmd_audit)
 
@@ -1238,14 +1438,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="draw a figure from a trajectory file",
         formatter_class=ex,
         epilog="examples:\n  eulerpoisson plot run.nc --kind omega --out omega.png\n  eulerpoisson plot run.nc --kind polhode --out polhode.pdf\n"
-               "  eulerpoisson plot top.nc --kind apex --out apex.png   # a top: its axis on the unit sphere\n"
-               "  eulerpoisson plot long.zarr --kind omega --out omega.png   # a streamed run: min/max per pixel column\n\n"
-               "Long runs (more than 20000 samples, and every .zarr store) are decimated: time series are drawn as\n"
-               "the min/max of the samples in each pixel column, the 3-D pictures from evenly strided samples.",
+        "  eulerpoisson plot top.nc --kind apex --out apex.png   # a top: its axis on the unit sphere\n"
+        "  eulerpoisson plot long.zarr --kind omega --out omega.png   # a streamed run: min/max per pixel column\n\n"
+        "Long runs (more than 20000 samples, and every .zarr store) are decimated: time series are drawn as\n"
+        "the min/max of the samples in each pixel column, the 3-D pictures from evenly strided samples.",
     )
-    pl.add_argument("file", help="trajectory written by 'simulate --out': a NetCDF file (version 4 or 3) or a .zarr "
-                    "store, read chunk by chunk (or a sweep store for --kind atlas)")
-    pl.add_argument("--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "apex", "atlas"])
+    pl.add_argument(
+        "file",
+        help="trajectory written by 'simulate --out': a NetCDF file (version 4 or 3) or a .zarr "
+        "store, read chunk by chunk (or a sweep store for --kind atlas)",
+    )
+    pl.add_argument(
+        "--kind", required=True, choices=["omega", "invariants", "polhode", "gibbs", "attitude", "apex", "atlas"]
+    )
     pl.add_argument("--out", help="figure file (.png, .svg or .pdf)")
     pl.add_argument("--quiet", action="store_true")
     pl.set_defaults(func=cmd_plot)
@@ -1258,7 +1463,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     an.add_argument("file", help="trajectory file: NetCDF (version 4 or 3) or a .zarr store")
     an.add_argument("--out", required=True, help="movie.html, movie.gif or movie.mp4")
-    an.add_argument("--fps", help=f"frames per second of a .gif/.mp4 ({FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}, default 30)")
+    an.add_argument(
+        "--fps", help=f"frames per second of a .gif/.mp4 ({FPS_RANGE[0]:g} to {FPS_RANGE[1]:g}, default 30)"
+    )
     an.add_argument("--quiet", action="store_true")
     an.set_defaults(func=cmd_animate)
 
@@ -1279,16 +1486,25 @@ def build_parser() -> argparse.ArgumentParser:
     sw.add_argument("config", help="TOML file describing the sweep (see examples/sweep.toml)")
     sw.add_argument("--out", help="Zarr store (default: [output] path of the file)")
     sw.add_argument("--scheduler", help="'local' (default, an embedded cluster), 'serial', or tcp://HOST:PORT")
-    sw.add_argument("-j", "--workers", type=int, metavar="N",
-                    help="worker processes of the local cluster, or threads with --scheduler serial "
-                         "(default: [compute] workers, else every core); the results do not depend on it")
+    sw.add_argument(
+        "-j",
+        "--workers",
+        type=int,
+        metavar="N",
+        help="worker processes of the local cluster, or threads with --scheduler serial "
+        "(default: [compute] workers, else every core); the results do not depend on it",
+    )
     sw.add_argument("--overwrite", action="store_true", help="replace a store made with another configuration")
     sw.add_argument("--quiet", action="store_true")
     sw.set_defaults(func=cmd_sweep)
 
-    i = sub.add_parser("info", help="describe a trajectory file", formatter_class=ex,
-                       epilog="examples:\n  eulerpoisson info run.nc\n  eulerpoisson info long.zarr   # a store: only its "
-                              "metadata and its first and last samples are read")
+    i = sub.add_parser(
+        "info",
+        help="describe a trajectory file",
+        formatter_class=ex,
+        epilog="examples:\n  eulerpoisson info run.nc\n  eulerpoisson info long.zarr   # a store: only its "
+        "metadata and its first and last samples are read",
+    )
     i.add_argument("file", help="trajectory file: NetCDF (version 4 or 3) or a .zarr store")
     i.set_defaults(func=cmd_info)
 
@@ -1312,8 +1528,6 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_warmup_command(sub)
     return p
-
-
 
 
 # ---------------------------------------------------------------------------
@@ -1355,7 +1569,10 @@ def _prepare_argv(argv: list[str], parser: argparse.ArgumentParser) -> list[str]
             i += 1
             continue
         if (
-            tok.startswith("--") and "=" not in tok and len(tok) > 2 and i + 1 < len(argv)
+            tok.startswith("--")
+            and "=" not in tok
+            and len(tok) > 2
+            and i + 1 < len(argv)
             and any(o.startswith(tok) for o in takes)
         ):
             nxt = argv[i + 1]
@@ -1390,8 +1607,9 @@ def _error_line(exc: BaseException) -> str:
         msg = f"out of memory: {msg}" if msg != type(exc).__name__ else "out of memory"
     elif isinstance(exc, OverflowError) and "overflow" not in msg.lower():
         msg = f"numerical overflow: {msg}"
-    elif not isinstance(exc, (EulerPoissonError, ValueError, TypeError, OSError, ArithmeticError, LookupError,
-                              ImportError)):
+    elif not isinstance(
+        exc, (EulerPoissonError, ValueError, TypeError, OSError, ArithmeticError, LookupError, ImportError)
+    ):
         msg = f"{type(exc).__name__}: {msg}"  # unexpected: say what kind of failure it was
     return f"eulerpoisson: error: {msg}"
 

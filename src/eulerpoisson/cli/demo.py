@@ -41,13 +41,29 @@ __all__ = ["run_demo", "run_top", "run_fit", "TENNIS_RACKET", "HEAVY_TOP", "TUMB
 TENNIS_RACKET: dict[str, Any] = {"inertia": (3.0, 5.0, 8.0), "M0": (0.0, 2.0, 0.01)}
 
 #: the heavy-top scene: inertia about the fixed point, torque, initial tilt (about x), spin, time span
-HEAVY_TOP: dict[str, Any] = {"inertia": (1.0, 1.0, 0.5), "mass": 1.0, "center_of_mass": (0.0, 0.0, 0.25), "g": (0.0, 0.0, -9.81),
-             "tilt_deg": 60.0, "omega0": (0.0, 0.0, 10.0), "t_end": 15.0, "samples": 3001}
+HEAVY_TOP: dict[str, Any] = {
+    "inertia": (1.0, 1.0, 0.5),
+    "mass": 1.0,
+    "center_of_mass": (0.0, 0.0, 0.25),
+    "g": (0.0, 0.0, -9.81),
+    "tilt_deg": 60.0,
+    "omega0": (0.0, 0.0, 10.0),
+    "t_end": 15.0,
+    "samples": 3001,
+}
 
 
 #: the fit scene: the tumbling body, its state at t = 0, the observations and their noise
-TUMBLER: dict[str, Any] = {"moments": (0.22, 0.35, 0.43), "omega0": (0.3, -0.2, 1.0), "attitude0": (0.7, 0.1, -0.5, 0.5),
-           "t_end": 40.0, "samples": 120, "sigma_attitude_deg": 0.1, "sigma_omega": 2e-3, "seed": 1}
+TUMBLER: dict[str, Any] = {
+    "moments": (0.22, 0.35, 0.43),
+    "omega0": (0.3, -0.2, 1.0),
+    "attitude0": (0.7, 0.1, -0.5, 0.5),
+    "t_end": 40.0,
+    "samples": 120,
+    "sigma_attitude_deg": 0.1,
+    "sigma_omega": 2e-3,
+    "seed": 1,
+}
 
 
 def run_fit(out, *, say=print) -> list[Path]:
@@ -88,14 +104,20 @@ def run_fit(out, *, say=print) -> list[Path]:
         files.append(png)
     moments = np.array(TUMBLER["moments"]) / np.sum(TUMBLER["moments"])
     say("eulerpoisson demo: spin-state estimation (ep.fit)")
-    say(f"  {t.size} noisy attitudes ({TUMBLER['sigma_attitude_deg']:g} deg) and body rates ({sw:g}) of a tumbling "
+    say(
+        f"  {t.size} noisy attitudes ({TUMBLER['sigma_attitude_deg']:g} deg) and body rates ({sw:g}) of a tumbling "
         f"body over t = 0..{TUMBLER['t_end']:g}; fitted from {res.n_starts} default starts in {wall:.2f} s, "
-        f"chi2/dof = {res.reduced_chi2:.3f}")
+        f"chi2/dof = {res.reduced_chi2:.3f}"
+    )
     say(f"  {'':10s}{'truth':>12s}{'estimate':>14s}{'+- sigma':>12s}")
-    rows = [("I_xx", moments[0], res.parameters["I_xx"], res.stderr["I_xx"]),
-            ("I_yy", moments[1], res.parameters["I_yy"], res.stderr["I_yy"]),
-            ("I_zz", moments[2], res.parameters["I_zz"], res.stderr["I_zz"])]
-    rows += [(f"omega0_{c}", TUMBLER["omega0"][i], res.omega0[i], res.stderr[f"omega0_{c}"]) for i, c in enumerate("xyz")]
+    rows = [
+        ("I_xx", moments[0], res.parameters["I_xx"], res.stderr["I_xx"]),
+        ("I_yy", moments[1], res.parameters["I_yy"], res.stderr["I_yy"]),
+        ("I_zz", moments[2], res.parameters["I_zz"], res.stderr["I_zz"]),
+    ]
+    rows += [
+        (f"omega0_{c}", TUMBLER["omega0"][i], res.omega0[i], res.stderr[f"omega0_{c}"]) for i, c in enumerate("xyz")
+    ]
     for name, tv, ev, se in rows:
         say(f"  {name:10s}{tv:12.6f}{ev:14.6f}{se:12.2e}")
     err = np.degrees(np.linalg.norm(res.attitude_error(q0)))
@@ -134,23 +156,34 @@ def run_top(out, *, say=print, t_end: float = HEAVY_TOP["t_end"], samples: int =
     png = out / "top_apex.png"
     plots.plot(traj, "apex", out=png)
     drift = traj.drift()
-    axis = np.einsum("tij,j->ti", traj.matrix, np.array(HEAVY_TOP["center_of_mass"]) / np.linalg.norm(
-        HEAVY_TOP["center_of_mass"]))
+    axis = np.einsum(
+        "tij,j->ti", traj.matrix, np.array(HEAVY_TOP["center_of_mass"]) / np.linalg.norm(HEAVY_TOP["center_of_mass"])
+    )
     theta = np.degrees(np.arccos(np.clip(axis[:, 2], -1.0, 1.0)))
     say("eulerpoisson demo: a heavy top (Lagrange top)")
-    say(f"  body: moments about the fixed point {body.principal_moments.tolist()}, mass {HEAVY_TOP['mass']:g}, "
-        f"centre of mass {list(HEAVY_TOP['center_of_mass'])}, g = {list(HEAVY_TOP['g'])}")
-    say(f"  released at {HEAVY_TOP['tilt_deg']:g} deg from the vertical, spinning at {HEAVY_TOP['omega0'][2]:g} rad/s; "
-        f"the axis nutates between {theta.min():.2f} and {theta.max():.2f} deg")
-    say(f"  taylor: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.2f} s; "
-        "max relative drift: " + ", ".join(f"{_DRIFT_NAMES.get(k, k)} {v:.1e}" for k, v in drift.items()))
+    say(
+        f"  body: moments about the fixed point {body.principal_moments.tolist()}, mass {HEAVY_TOP['mass']:g}, "
+        f"centre of mass {list(HEAVY_TOP['center_of_mass'])}, g = {list(HEAVY_TOP['g'])}"
+    )
+    say(
+        f"  released at {HEAVY_TOP['tilt_deg']:g} deg from the vertical, spinning at {HEAVY_TOP['omega0'][2]:g} rad/s; "
+        f"the axis nutates between {theta.min():.2f} and {theta.max():.2f} deg"
+    )
+    say(
+        f"  taylor: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.2f} s; "
+        "max relative drift: " + ", ".join(f"{_DRIFT_NAMES.get(k, k)} {v:.1e}" for k, v in drift.items())
+    )
     if exact is not None:
         dq = float(np.max(np.abs(np.abs(np.sum(exact.quaternion * traj.quaternion, -1)) - 1.0)))
         dw = float(np.max(np.abs(exact.omega - traj.omega)))
-        say(f"  closed form (exact) beside taylor: max |omega difference| {dw:.1e} rad/s, "
-            f"max 1-|q_exact.q_taylor| {dq:.1e}")
+        say(
+            f"  closed form (exact) beside taylor: max |omega difference| {dw:.1e} rad/s, "
+            f"max 1-|q_exact.q_taylor| {dq:.1e}"
+        )
     else:
-        say("  closed form (exact): not run, " + why.split(";")[0].replace("method 'exact' cannot run this model: ", ""))
+        say(
+            "  closed form (exact): not run, " + why.split(";")[0].replace("method 'exact' cannot run this model: ", "")
+        )
     return [nc, png]
 
 
@@ -220,12 +253,19 @@ def run_demo(out="out", *, quiet: bool = False, t_end: float = 400.0, samples: i
     say("eulerpoisson demo: the tennis-racket effect")
     say(f"  body: principal moments {body.principal_moments.tolist()}, initial body momentum M0 = {M0.tolist()}")
     say(f"  flips of Omega_2 observed in [0, {t_end:g}]: {len(flips)}")
-    say(f"  time between flips: measured {half_measured:.12g}, closed form 2K(k)/lambda = {half_exact:.12g}"
-        f" (relative difference {abs(half_measured - half_exact) / half_exact:.1e})")
+    say(
+        f"  time between flips: measured {half_measured:.12g}, closed form 2K(k)/lambda = {half_exact:.12g}"
+        f" (relative difference {abs(half_measured - half_exact) / half_exact:.1e})"
+    )
     say("  integrals of motion, max relative drift: " + ", ".join(f"{k} {v:.1e}" for k, v in drift.items()))
     counts = report.summary()["counts"]
-    say("  audit of the paper: " + ", ".join(f"{v} {k}" for k, v in counts.items())
-        + " (misprints in eq. " + ", ".join(m["equation"] for m in report.summary()["misprints"]) + ")")
+    say(
+        "  audit of the paper: "
+        + ", ".join(f"{v} {k}" for k, v in counts.items())
+        + " (misprints in eq. "
+        + ", ".join(m["equation"] for m in report.summary()["misprints"])
+        + ")"
+    )
     for line in top_lines + fit_lines:
         say(line)
     say(f"  wrote {len(files)} files into {out}/ in {wall:.1f} s:")

@@ -75,10 +75,14 @@ def cmd_fit(args) -> int:
             raise UsageError(f"{name}: empty file name")
     if not os.path.exists(args.file):
         raise UsageError(f"{args.file}: no such file (observations: .csv, .nc or .toml)")
-    obs = read_observations(args.file, sigma_attitude_deg=_positive(args.sigma_attitude, "--sigma-attitude"),
-                            sigma_omega=_positive(args.sigma_omega, "--sigma-omega"),
-                            sigma_axis_deg=_positive(args.sigma_axis, "--sigma-axis"),
-                            omega_frame=args.omega_frame, axis=_vector(args.axis, "--axis"))
+    obs = read_observations(
+        args.file,
+        sigma_attitude_deg=_positive(args.sigma_attitude, "--sigma-attitude"),
+        sigma_omega=_positive(args.sigma_omega, "--sigma-omega"),
+        sigma_axis_deg=_positive(args.sigma_axis, "--sigma-axis"),
+        omega_frame=args.omega_frame,
+        axis=_vector(args.axis, "--axis"),
+    )
     kwargs = obs.fit_kwargs()
     if args.principal_axes is not None:
         kwargs["principal_axes"] = args.principal_axes
@@ -91,8 +95,9 @@ def cmd_fit(args) -> int:
             raise UsageError(f"--plot {args.plot!r} is a file; give a folder for the figures")
         clash = [f for f in PLOT_FILES if os.path.exists(os.path.join(args.plot, f))]
         if clash and not args.overwrite:
-            raise UsageError(f"--plot {args.plot!r} already holds {', '.join(clash)}; run again with --overwrite "
-                             f"to replace them")
+            raise UsageError(
+                f"--plot {args.plot!r} already holds {', '.join(clash)}; run again with --overwrite to replace them"
+            )
     t = kwargs.pop("t")
     res = fit(t, **kwargs)
     if args.out is not None:
@@ -116,9 +121,9 @@ def add_commands(sub) -> None:
         help="fit a torque-free body (inertia ratios, attitude and rate at t0) to observations of its rotation",
         formatter_class=ex,
         description="Spin-state estimation: the inertia ratios (trace 1) and the attitude and body angular velocity "
-                    "at the first observation that best explain observed attitudes, angular velocities and axis "
-                    "directions, with standard errors, the distinct optima found from starts on both sides of the "
-                    "separatrix, and the fit's chi2.",
+        "at the first observation that best explain observed attitudes, angular velocities and axis "
+        "directions, with standard errors, the distinct optima found from starts on both sides of the "
+        "separatrix, and the fit's chi2.",
         epilog=(
             "examples:\n" + "\n".join(f"  {e}" for e in FIT_EXAMPLES) + "\n\n"
             "FILE: a CSV with a header row: t; qw,qx,qy,qz or euler_<SEQ>_1..3 (degrees, SEQ as scipy: ZXZ\n"
@@ -129,17 +134,34 @@ def add_commands(sub) -> None:
         ),
     )
     f.add_argument("file", help="observations: .csv, .nc or .toml")
-    f.add_argument("--sigma-attitude", dest="sigma_attitude", metavar="DEG",
-                   help="standard deviation of the attitudes about each axis, degrees")
-    f.add_argument("--sigma-omega", dest="sigma_omega", metavar="RATE",
-                   help="standard deviation of each angular-velocity component (the file's units)")
-    f.add_argument("--sigma-axis", dest="sigma_axis", metavar="DEG",
-                   help="standard deviation of the axis directions, degrees")
-    f.add_argument("--omega-frame", dest="omega_frame", choices=("body", "space"),
-                   help="frame of wx,wy,wz (default body, or the file's)")
+    f.add_argument(
+        "--sigma-attitude",
+        dest="sigma_attitude",
+        metavar="DEG",
+        help="standard deviation of the attitudes about each axis, degrees",
+    )
+    f.add_argument(
+        "--sigma-omega",
+        dest="sigma_omega",
+        metavar="RATE",
+        help="standard deviation of each angular-velocity component (the file's units)",
+    )
+    f.add_argument(
+        "--sigma-axis", dest="sigma_axis", metavar="DEG", help="standard deviation of the axis directions, degrees"
+    )
+    f.add_argument(
+        "--omega-frame",
+        dest="omega_frame",
+        choices=("body", "space"),
+        help="frame of wx,wy,wz (default body, or the file's)",
+    )
     f.add_argument("--axis", metavar="X,Y,Z", help="the body axis whose space direction ax,ay,az is observed")
-    f.add_argument("--principal-axes", dest="principal_axes", choices=("given", "fit"),
-                   help="'given': inertia diagonal in the body frame of the data (default); 'fit': a full tensor")
+    f.add_argument(
+        "--principal-axes",
+        dest="principal_axes",
+        choices=("given", "fit"),
+        help="'given': inertia diagonal in the body frame of the data (default); 'fit': a full tensor",
+    )
     f.add_argument("--inertia", help="fix the inertia (I1,I2,I3 or nine numbers): fit the state only")
     f.add_argument("--out", metavar="FILE", help="write the result as JSON")
     f.add_argument("--plot", metavar="DIR", help="write residuals.png, fit.png and polhode.png into DIR")

@@ -67,8 +67,14 @@ def cmd_validate(args) -> int:
 
         check_output(args.plot, "file", overwrite=bool(args.overwrite), inputs=[args.run])
     try:
-        rep = validate(args.run, inertia, quaternion_order=args.quaternion_order, omega_frame=args.omega_frame,
-                       attitude_convention=args.attitude_convention, tolerance=tol)
+        rep = validate(
+            args.run,
+            inertia,
+            quaternion_order=args.quaternion_order,
+            omega_frame=args.omega_frame,
+            attitude_convention=args.attitude_convention,
+            tolerance=tol,
+        )
     except InvalidInputError as exc:
         msg = str(exc).splitlines()[0]
         if "the run does not state it" in msg:
@@ -96,11 +102,15 @@ def cmd_validate(args) -> int:
         if rep.flip_times is not None and rep.flip_time_errors is not None:  # (set together)
             lines.append(f"  flips (exact)      {_fmt_times(rep.flip_times)}")
             errs = [e for e in rep.flip_time_errors if math.isfinite(e)]
-            lines.append("  flip time errors   " + (", ".join(f"{e:+.3e}" for e in rep.flip_time_errors[:6])
-                                                       if errs else "the run does not flip"))
+            lines.append(
+                "  flip time errors   "
+                + (", ".join(f"{e:+.3e}" for e in rep.flip_time_errors[:6]) if errs else "the run does not flip")
+            )
         if rep.tolerance is not None:
-            lines.append(f"  tolerance          {rep.tolerance:g} rad: " +
-                         (f"exceeded at t = {rep.exceeded_at:.6g}" if rep.exceeded_at is not None else "never exceeded"))
+            lines.append(
+                f"  tolerance          {rep.tolerance:g} rad: "
+                + (f"exceeded at t = {rep.exceeded_at:.6g}" if rep.exceeded_at is not None else "never exceeded")
+            )
         lines.append(f"  verdict            {rep.verdict.upper()}: {rep.message}")
         if args.plot:
             lines.append(f"  wrote {args.plot}")
@@ -117,17 +127,22 @@ def cmd_cases(args) -> int:
         names = [n.strip() for n in args.only.split(",") if n.strip()]
         unknown = [n for n in names if n not in CASE_NAMES]
         if unknown or not names:
-            raise UsageError(f"--only: unknown case(s) {', '.join(unknown) or '(none given)'}; cases: {', '.join(CASE_NAMES)}")
+            raise UsageError(
+                f"--only: unknown case(s) {', '.join(unknown) or '(none given)'}; cases: {', '.join(CASE_NAMES)}"
+            )
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         raise UsageError(f"--out {args.out!r} is a file; give a folder")
     if os.path.isdir(args.out) and os.listdir(args.out):
         # the output policy: only a folder of cases written before, and only with --overwrite
         if not os.path.exists(os.path.join(args.out, "cases.json")):
-            raise UsageError(f"--out {args.out!r} is a folder with other files in it, not a folder of cases; "
-                             f"give a new or empty folder (--overwrite never replaces it)")
+            raise UsageError(
+                f"--out {args.out!r} is a folder with other files in it, not a folder of cases; "
+                f"give a new or empty folder (--overwrite never replaces it)"
+            )
         if not args.overwrite:
-            raise UsageError(f"--out {args.out!r} holds cases written before; run again with --overwrite to "
-                             f"replace them")
+            raise UsageError(
+                f"--out {args.out!r} holds cases written before; run again with --overwrite to replace them"
+            )
     files = write_cases(args.out, names, netcdf=not args.csv_only)
     if not args.quiet:
         print(f"wrote {len(files)} files into {args.out} (README.md lists the cases)")
@@ -144,8 +159,8 @@ def add_commands(sub) -> None:
         help="validate another simulator's free rigid-body run against the exact motion",
         formatter_class=ex,
         description="Compare a run (attitude and angular velocity samples of a free body) with the exact motion "
-                    "from its first sample: attitude and rate errors, the run's energy and momentum drift, the "
-                    "tennis-racket flips, a verdict. Exit 0, 1 when --tolerance is exceeded, 2 on bad input.",
+        "from its first sample: attitude and rate errors, the run's energy and momentum drift, the "
+        "tennis-racket flips, a verdict. Exit 0, 1 when --tolerance is exceeded, 2 on bad input.",
         epilog=(
             "examples:\n" + "\n".join(f"  {e}" for e in VALIDATE_EXAMPLES) + "\n\n"
             "RUN: a CSV with header t,qw,qx,qy,qz,wx,wy,wz (any column order: the names say the order, or\n"
@@ -156,12 +171,26 @@ def add_commands(sub) -> None:
     )
     v.add_argument("run", help="the run: .csv, .nc or .json")
     v.add_argument("--inertia", help="principal moments I1,I2,I3 or nine numbers of the tensor in the run's body frame")
-    v.add_argument("--quaternion-order", dest="quaternion_order", choices=QUATERNION_ORDERS,
-                   help="order of the four quaternion columns as they appear (default: as the column names say)")
-    v.add_argument("--omega-frame", dest="omega_frame", choices=OMEGA_FRAMES, default="body",
-                   help="frame of the angular velocity columns (default body)")
-    v.add_argument("--attitude-convention", dest="attitude_convention", choices=ATTITUDE_CONVENTIONS,
-                   default="body-to-space", help="what the quaternion rotates (default body-to-space: x_space = R x_body)")
+    v.add_argument(
+        "--quaternion-order",
+        dest="quaternion_order",
+        choices=QUATERNION_ORDERS,
+        help="order of the four quaternion columns as they appear (default: as the column names say)",
+    )
+    v.add_argument(
+        "--omega-frame",
+        dest="omega_frame",
+        choices=OMEGA_FRAMES,
+        default="body",
+        help="frame of the angular velocity columns (default body)",
+    )
+    v.add_argument(
+        "--attitude-convention",
+        dest="attitude_convention",
+        choices=ATTITUDE_CONVENTIONS,
+        default="body-to-space",
+        help="what the quaternion rotates (default body-to-space: x_space = R x_body)",
+    )
     v.add_argument("--tolerance", metavar="RAD", help="attitude tolerance in radians: exit 1 when exceeded")
     v.add_argument("--json", action="store_true", help="print the report as one JSON object")
     v.add_argument("--plot", metavar="FILE", help="draw the attitude error and the drift over time (.png, .svg, .pdf)")

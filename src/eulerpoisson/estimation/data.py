@@ -130,9 +130,15 @@ class ObservationSet:
         x = self.t[self.ax_idx] <= t_end
         return replace(
             self,
-            att_idx=self.att_idx[a], att_q=self.att_q[a], att_sigma=self.att_sigma[a],
-            om_idx=self.om_idx[o], om_value=self.om_value[o], om_sigma=self.om_sigma[o],
-            ax_idx=self.ax_idx[x], ax_dir=self.ax_dir[x], ax_sigma=self.ax_sigma[x],
+            att_idx=self.att_idx[a],
+            att_q=self.att_q[a],
+            att_sigma=self.att_sigma[a],
+            om_idx=self.om_idx[o],
+            om_value=self.om_value[o],
+            om_sigma=self.om_sigma[o],
+            ax_idx=self.ax_idx[x],
+            ax_dir=self.ax_dir[x],
+            ax_sigma=self.ax_sigma[x],
         )
 
 
@@ -172,7 +178,9 @@ def _rows(x, name, n, width) -> np.ndarray:
     part = np.isnan(a).any(axis=1) & ~np.isnan(a).all(axis=1)
     if np.any(part):
         i = int(np.flatnonzero(part)[0])
-        raise FitInputError(f"{name} row {i} is partly NaN ({a[i].tolist()}): a missing observation is a whole row of NaN")
+        raise FitInputError(
+            f"{name} row {i} is partly NaN ({a[i].tolist()}): a missing observation is a whole row of NaN"
+        )
     return a
 
 
@@ -222,12 +230,24 @@ def _sigma(sig, name, n, width, present) -> tuple[np.ndarray, bool]:
     if not np.all(np.isfinite(used)) or np.any(used <= 0):
         bad = ~(np.isfinite(used) & (used > 0))
         i = int(np.flatnonzero(present)[np.flatnonzero(bad.any(axis=1))[0]])
-        raise FitInputError(f"{name} must be positive and finite where there is an observation; row {i} has {s[i].tolist()}")
+        raise FitInputError(
+            f"{name} must be positive and finite where there is an observation; row {i} has {s[i].tolist()}"
+        )
     return s, True
 
 
-def observation_set(t, *, attitude=None, attitude_sigma=None, omega=None, omega_sigma=None, omega_frame="body",
-                    axis=None, axis_direction=None, axis_sigma=None) -> ObservationSet:
+def observation_set(
+    t,
+    *,
+    attitude=None,
+    attitude_sigma=None,
+    omega=None,
+    omega_sigma=None,
+    omega_frame="body",
+    axis=None,
+    axis_direction=None,
+    axis_sigma=None,
+) -> ObservationSet:
     """Check and arrange observations (see the module docstring).
 
     Raises

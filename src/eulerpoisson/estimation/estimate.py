@@ -92,8 +92,9 @@ def _same(a: LocalOptimum, b: LocalOptimum) -> bool:
         return False
     ang = np.linalg.norm(log_quaternion(qmul(a.q0 * CONJUGATE, b.q0)))
     scale = 1.0 + np.linalg.norm(a.omega0)
-    return bool(np.abs(a.inertia - b.inertia).max() < 1e-4 and np.abs(a.omega0 - b.omega0).max() < 1e-4 * scale
-                and ang < 1e-4)
+    return bool(
+        np.abs(a.inertia - b.inertia).max() < 1e-4 and np.abs(a.omega0 - b.omega0).max() < 1e-4 * scale and ang < 1e-4
+    )
 
 
 #: after each window but the last, a start is dropped when its chi2 exceeds RACE_FACTOR times the best one's
@@ -122,8 +123,14 @@ def _race(layout, obs, starts, ends, max_iter):
         results = []
         for state, prior in live:
             try:
-                out = levenberg_marquardt(layout, sub, state, max_iter=max_iter if final else 40,
-                                          rtol=1e-12 if final else 1e-6, prior=None if final else prior)
+                out = levenberg_marquardt(
+                    layout,
+                    sub,
+                    state,
+                    max_iter=max_iter if final else 40,
+                    rtol=1e-12 if final else 1e-6,
+                    prior=None if final else prior,
+                )
             except FloatingPointError:
                 continue
             results.append((out, prior))
@@ -164,13 +171,19 @@ def _sigma_scales(layout, obs, ev):
     frac = max(1.0 - layout.n_params / n_total, 1e-3)
     scales = {}
     start = 0
-    kinds = (("attitude", 3 * len(obs.att_idx), obs.att_sigma, 1.0),
-             ("omega", 3 * len(obs.om_idx), obs.om_sigma,
-              float(np.median(np.linalg.norm(obs.om_value, axis=1))) if len(obs.om_idx) else 1.0),
-             ("axis", 2 * len(obs.ax_idx), obs.ax_sigma, 1.0))
+    kinds = (
+        ("attitude", 3 * len(obs.att_idx), obs.att_sigma, 1.0),
+        (
+            "omega",
+            3 * len(obs.om_idx),
+            obs.om_sigma,
+            float(np.median(np.linalg.norm(obs.om_value, axis=1))) if len(obs.om_idx) else 1.0,
+        ),
+        ("axis", 2 * len(obs.ax_idx), obs.ax_sigma, 1.0),
+    )
     for kind, n, sig, ref in kinds:
         if n:
-            r = ev.residuals[start:start + n]
+            r = ev.residuals[start : start + n]
             if not obs.sigma_given.get(kind, False):
                 current = float(np.median(sig))
                 floor = SIGMA_FLOOR * (ref if ref > 0 else 1.0) / current
@@ -179,9 +192,22 @@ def _sigma_scales(layout, obs, ev):
     return scales
 
 
-def fit(t: ArrayLike, *, attitude: AttitudeLike | None = None, attitude_sigma: ArrayLike | None = None, omega: ArrayLike | None = None, omega_sigma: ArrayLike | None = None, omega_frame: str = "body", axis: ArrayLike | None = None,
-        axis_direction: ArrayLike | None = None, axis_sigma: ArrayLike | None = None, inertia: RigidBody | ArrayLike | None = None, principal_axes: str = "given", initial: Mapping[str, ArrayLike] | None = None,
-        max_iter: int = 200) -> FitResult:
+def fit(
+    t: ArrayLike,
+    *,
+    attitude: AttitudeLike | None = None,
+    attitude_sigma: ArrayLike | None = None,
+    omega: ArrayLike | None = None,
+    omega_sigma: ArrayLike | None = None,
+    omega_frame: str = "body",
+    axis: ArrayLike | None = None,
+    axis_direction: ArrayLike | None = None,
+    axis_sigma: ArrayLike | None = None,
+    inertia: RigidBody | ArrayLike | None = None,
+    principal_axes: str = "given",
+    initial: Mapping[str, ArrayLike] | None = None,
+    max_iter: int = 200,
+) -> FitResult:
     r"""Fit a torque-free rigid body to observations of its rotation: inertia ratios and the initial state.
 
     Parameters
@@ -255,8 +281,17 @@ def fit(t: ArrayLike, *, attitude: AttitudeLike | None = None, attitude_sigma: A
     if max_iter < 0:
         raise FitInputError(f"max_iter must be a non-negative integer, got {max_iter}")
     max_iter = int(max_iter)
-    obs = observation_set(t, attitude=attitude, attitude_sigma=attitude_sigma, omega=omega, omega_sigma=omega_sigma,
-                          omega_frame=omega_frame, axis=axis, axis_direction=axis_direction, axis_sigma=axis_sigma)
+    obs = observation_set(
+        t,
+        attitude=attitude,
+        attitude_sigma=attitude_sigma,
+        omega=omega,
+        omega_sigma=omega_sigma,
+        omega_frame=omega_frame,
+        axis=axis,
+        axis_direction=axis_direction,
+        axis_sigma=axis_sigma,
+    )
     if principal_axes not in PRINCIPAL_AXES:
         raise FitInputError(f"principal_axes must be 'given' or 'fit'; got {principal_axes!r}")
     if inertia is not None:
@@ -306,14 +341,16 @@ def fit(t: ArrayLike, *, attitude: AttitudeLike | None = None, attitude_sigma: A
             else:  # far worse: re-weighed, not refitted
                 again = LMOutcome(out.state, evaluate(layout, obs, out.state), 0, out.converged)
             I, _ = inertia_matrix(layout, again.state.inertia_params)
-            refined.append((LocalOptimum(again.evaluation.chi2, I, again.state.q0, again.state.omega0,
-                                         again.converged), again))
+            refined.append(
+                (LocalOptimum(again.evaluation.chi2, I, again.state.q0, again.state.omega0, again.converged), again)
+            )
         found = sorted(refined, key=lambda f: f[0].chi2)
     found, n_equivalent = _prefer_slowest(found)
     best = found[0][1]
     final = evaluate(layout, obs, best.state)
-    return FitResult._from_search(layout, obs, best, final, [f[0] for f in found], estimated, len(start_list),
-                                  n_equivalent)
+    return FitResult._from_search(
+        layout, obs, best, final, [f[0] for f in found], estimated, len(start_list), n_equivalent
+    )
 
 
 def _prefer_slowest(found):

@@ -44,7 +44,7 @@ def retract(layout: Layout, state: FitState, delta) -> FitState:
     if na:
         q0 = qmul(q0, exp_quaternion(delta[:3]))
         q0 = q0 / np.linalg.norm(q0)
-    return FitState(q0, state.omega0 + delta[na:na + 3], state.inertia_params + delta[na + 3:])
+    return FitState(q0, state.omega0 + delta[na : na + 3], state.inertia_params + delta[na + 3 :])
 
 
 def _valid(layout, state):
@@ -77,8 +77,9 @@ def _try(layout, obs, state, prior):
     return ev
 
 
-def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int = 200, rtol: float = 1e-12,
-                        prior=None) -> LMOutcome:
+def levenberg_marquardt(
+    layout: Layout, obs, state: FitState, *, max_iter: int = 200, rtol: float = 1e-12, prior=None
+) -> LMOutcome:
     r"""Minimize the weighted sum of squares from ``state``.
 
     Stops when a kept step lowers :math:`\\chi^2` by less than ``rtol`` relative
@@ -137,8 +138,11 @@ def levenberg_marquardt(layout: Layout, obs, state: FitState, *, max_iter: int =
                 converged = True
                 break
         else:
-            if new is not None and (ev.chi2 - new.chi2) >= -1e-15 * ev.chi2 and \
-                    np.sqrt(step @ (d * step)) <= 1e-9 * np.sqrt(ev.chi2 + 1e-300):
+            if (
+                new is not None
+                and (ev.chi2 - new.chi2) >= -1e-15 * ev.chi2
+                and np.sqrt(step @ (d * step)) <= 1e-9 * np.sqrt(ev.chi2 + 1e-300)
+            ):
                 converged = True  # at round-off level
                 break
             lam *= nu

@@ -134,7 +134,7 @@ def plot_polhode(result, ax=None, samples: int = 2000):
         ax = fig.add_subplot(projection="3d")
     else:
         fig = ax.figure
-    u, v = np.mgrid[0:2 * np.pi:40j, 0:np.pi:20j]
+    u, v = np.mgrid[0 : 2 * np.pi : 40j, 0 : np.pi : 20j]
     ax.plot_wireframe(L * np.cos(u) * np.sin(v), L * np.sin(u) * np.sin(v), L * np.cos(v), color="0.85", lw=0.4)
     ax.plot(M[:, 0], M[:, 1], M[:, 2], color="C3", lw=1.5, label="fitted polhode")
     obs = result.observations

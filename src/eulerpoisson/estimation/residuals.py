@@ -127,9 +127,14 @@ def log_quaternion(q) -> np.ndarray:
 
 def _skew(v):
     z = np.zeros(v.shape[:-1])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
-                     np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+    return np.stack(
+        [
+            np.stack([z, -v[..., 2], v[..., 1]], -1),
+            np.stack([v[..., 2], z, -v[..., 0]], -1),
+            np.stack([-v[..., 1], v[..., 0], z], -1),
+        ],
+        -2,
+    )
 
 
 def _jr_inv(r):
@@ -165,8 +170,9 @@ class Evaluation:
     omega: np.ndarray
 
 
-def evaluate(layout: Layout, obs: ObservationSet, state: FitState, *, jacobian: bool = True,
-             tol: float = 2.0**-52) -> Evaluation:
+def evaluate(
+    layout: Layout, obs: ObservationSet, state: FitState, *, jacobian: bool = True, tol: float = 2.0**-52
+) -> Evaluation:
     """Whitened residuals (attitude, then rate, then direction rows) and their Jacobian at ``state``.
 
     Raises

@@ -58,8 +58,13 @@ class LocalOptimum:
             object.__setattr__(self, name, a)
 
     def as_dict(self) -> dict[str, Any]:
-        return {"chi2": float(self.chi2), "inertia": self.inertia.tolist(), "attitude0": self.q0.tolist(),
-                "omega0": self.omega0.tolist(), "converged": bool(self.converged)}
+        return {
+            "chi2": float(self.chi2),
+            "inertia": self.inertia.tolist(),
+            "attitude0": self.q0.tolist(),
+            "omega0": self.omega0.tolist(),
+            "converged": bool(self.converged),
+        }
 
 
 def _frozen(v):
@@ -198,10 +203,10 @@ class FitResult:
         J = final.jacobian
         cov, determined = _covariance(J)
         names = layout.names
-        values = {n: 0.0 for n in names[:layout.n_attitude]}
+        values = {n: 0.0 for n in names[: layout.n_attitude]}
         for i, n in enumerate(("omega0_x", "omega0_y", "omega0_z")):
             values[n] = float(best.state.omega0[i])
-        for n, v in zip(names[layout.n_attitude + 3:], best.state.inertia_params):
+        for n, v in zip(names[layout.n_attitude + 3 :], best.state.inertia_params):
             values[n] = float(v)
         se = np.sqrt(np.diag(cov))
         stderr = {n: float(s) for n, s in zip(names, se)}
@@ -223,12 +228,14 @@ class FitResult:
         residuals = {}
         start = 0
         res = final.residuals
-        for kind, idx, width, sig in (("attitude", obs.att_idx, 3, obs.att_sigma[:, None] if len(obs.att_idx) else None),
-                                      ("omega", obs.om_idx, 3, obs.om_sigma),
-                                      ("axis", obs.ax_idx, 2, obs.ax_sigma[:, None] if len(obs.ax_idx) else None)):
+        for kind, idx, width, sig in (
+            ("attitude", obs.att_idx, 3, obs.att_sigma[:, None] if len(obs.att_idx) else None),
+            ("omega", obs.om_idx, 3, obs.om_sigma),
+            ("axis", obs.ax_idx, 2, obs.ax_sigma[:, None] if len(obs.ax_idx) else None),
+        ):
             size = width * len(idx)
             if size:
-                residuals[kind] = res[start:start + size].reshape(-1, width) * sig
+                residuals[kind] = res[start : start + size].reshape(-1, width) * sig
                 residuals[kind + "_t"] = obs.t[idx]
                 start += size
         sigma = {}
@@ -240,14 +247,32 @@ class FitResult:
             sigma["axis"] = float(np.median(obs.ax_sigma))
         dof = len(res) - layout.n_params
         return cls(
-            epoch=float(obs.t[0]), inertia=I, principal_moments=ev, principal_axes=V,
-            attitude0=Attitude(best.state.q0), omega0=best.state.omega0.copy(),
-            parameter_names=names, parameters=values, covariance=cov, stderr=stderr, determined=determined,
-            chi2=float(final.chi2), dof=int(dof), reduced_chi2=float(final.chi2 / dof) if dof > 0 else float("nan"),
-            residuals=residuals, sigma=sigma, sigma_estimated=tuple(sorted(estimated)),
-            local_optima=list(optima), converged=bool(best.converged), n_starts=int(n_starts),
-            principal_axes_mode=layout.inertia_mode, observations=obs, n_equivalent=int(n_equivalent), _model_q=final.quaternion,
-            _model_omega=final.omega, _model_rows=final.rows,
+            epoch=float(obs.t[0]),
+            inertia=I,
+            principal_moments=ev,
+            principal_axes=V,
+            attitude0=Attitude(best.state.q0),
+            omega0=best.state.omega0.copy(),
+            parameter_names=names,
+            parameters=values,
+            covariance=cov,
+            stderr=stderr,
+            determined=determined,
+            chi2=float(final.chi2),
+            dof=int(dof),
+            reduced_chi2=float(final.chi2 / dof) if dof > 0 else float("nan"),
+            residuals=residuals,
+            sigma=sigma,
+            sigma_estimated=tuple(sorted(estimated)),
+            local_optima=list(optima),
+            converged=bool(best.converged),
+            n_starts=int(n_starts),
+            principal_axes_mode=layout.inertia_mode,
+            observations=obs,
+            n_equivalent=int(n_equivalent),
+            _model_q=final.quaternion,
+            _model_omega=final.omega,
+            _model_rows=final.rows,
         )
 
     # ------------------------------------------------------------------
@@ -311,8 +336,11 @@ class FitResult:
             "principal_axes_mode": self.principal_axes_mode,
             "n_observations": {k: int(len(v)) for k, v in self.residuals.items() if not k.endswith("_t")},
             "local_optima": [o.as_dict() for o in self.local_optima],
-            "rms_residuals": {k: float(np.sqrt(np.mean(np.asarray(v) ** 2))) for k, v in self.residuals.items()
-                              if not k.endswith("_t")},
+            "rms_residuals": {
+                k: float(np.sqrt(np.mean(np.asarray(v) ** 2)))
+                for k, v in self.residuals.items()
+                if not k.endswith("_t")
+            },
         }
         return _finite_or_none(d)
 
@@ -330,30 +358,49 @@ class FitResult:
         lines = []
         kinds = ", ".join(f"{k} {len(v)}" for k, v in self.residuals.items() if not k.endswith("_t"))
         lines.append(f"fit of a torque-free body: observations {kinds}; epoch t0 = {self.epoch:g}")
-        lines.append(f"  chi2 = {self.chi2:.6g}, dof = {self.dof}, reduced chi2 = {self.reduced_chi2:.4g}"
-                     + ("" if self.converged else "  (NOT converged)"))
+        lines.append(
+            f"  chi2 = {self.chi2:.6g}, dof = {self.dof}, reduced chi2 = {self.reduced_chi2:.4g}"
+            + ("" if self.converged else "  (NOT converged)")
+        )
         if self.sigma_estimated:
-            lines.append("  sigma estimated from the residuals: " + ", ".join(
-                f"{k} {self.sigma[k]:.3g}" for k in self.sigma_estimated))
+            lines.append(
+                "  sigma estimated from the residuals: "
+                + ", ".join(f"{k} {self.sigma[k]:.3g}" for k in self.sigma_estimated)
+            )
         lines.append(f"  {'parameter':<14}{'value':>16}{'stderr':>14}")
         for n in list(self.parameter_names) + [k for k in ("I_zz", "I_1", "I_2", "I_3") if k in self.parameters]:
             lines.append(f"  {n:<14}{self.parameters[n]:>16.9g}{self.stderr[n]:>14.3g}")
         if not self.determined:
-            lines.append("  the data do not determine every unknown (singular normal matrix): fix the inertia or add data")
+            lines.append(
+                "  the data do not determine every unknown (singular normal matrix): fix the inertia or add data"
+            )
         q = self.attitude0.as_quaternion()
         if "attitude0_x" in self.parameters:
-            lines.append("  attitude0 (w, x, y, z) = (" + ", ".join(f"{x:.9f}" for x in q) + ")"
-                         + "  [attitude0_x/y/z: rotation about it, rad]")
+            lines.append(
+                "  attitude0 (w, x, y, z) = ("
+                + ", ".join(f"{x:.9f}" for x in q)
+                + ")"
+                + "  [attitude0_x/y/z: rotation about it, rad]"
+            )
         else:
-            lines.append("  attitude0: not seen by the data (body-frame rates only); predictions start from the identity")
-        lines.append("  principal moments (trace 1) = (" + ", ".join(f"{x:.6f}" for x in self.principal_moments)
-                     + f"); motion: {self.mode}")
+            lines.append(
+                "  attitude0: not seen by the data (body-frame rates only); predictions start from the identity"
+            )
+        lines.append(
+            "  principal moments (trace 1) = ("
+            + ", ".join(f"{x:.6f}" for x in self.principal_moments)
+            + f"); motion: {self.mode}"
+        )
         if self.n_equivalent > 1:
-            lines.append(f"  {self.n_equivalent} optima fit the data equally well (delta chi2 < 1; evenly spaced "
-                         f"samples alias): the slowest motion is reported, see local_optima")
+            lines.append(
+                f"  {self.n_equivalent} optima fit the data equally well (delta chi2 < 1; evenly spaced "
+                f"samples alias): the slowest motion is reported, see local_optima"
+            )
         if len(self.local_optima) > 1:
-            lines.append(f"  {len(self.local_optima)} distinct optima from {self.n_starts} starts (chi2): "
-                         + ", ".join(f"{o.chi2:.6g}" for o in self.local_optima[:6]))
+            lines.append(
+                f"  {len(self.local_optima)} distinct optima from {self.n_starts} starts (chi2): "
+                + ", ".join(f"{o.chi2:.6g}" for o in self.local_optima[:6])
+            )
         else:
             lines.append(f"  one optimum from {self.n_starts} starts")
         return "\n".join(lines)

@@ -221,8 +221,9 @@ def starts(obs: ObservationSet, layout: Layout, *, extra_inertias=()) -> list[Fi
             ws = [w] + aliases
         for w0 in ws:
             for q0 in attitude_guesses(obs, layout, I, w0):
-                out.append(FitState(q0, np.array(w0, dtype=float), params_of(mode, I) if mode != "fixed"
-                                    else np.zeros(0)))
+                out.append(
+                    FitState(q0, np.array(w0, dtype=float), params_of(mode, I) if mode != "fixed" else np.zeros(0))
+                )
     return out
 
 

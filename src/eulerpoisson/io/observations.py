@@ -137,8 +137,14 @@ _EULER_RE = re.compile(r"^euler_([A-Za-z]{3})_([123])$")
 
 #: every CSV column name, in the order of the module notes (``SEQ``: a 3-letter axis sequence)
 CSV_COLUMNS = (
-    ("t",) + _Q_COLS + ("euler_SEQ_1", "euler_SEQ_2", "euler_SEQ_3") + _W_COLS + _A_COLS
-    + ("sigma_attitude_deg", "sigma_omega") + _SW_COLS + ("sigma_axis_deg",)
+    ("t",)
+    + _Q_COLS
+    + ("euler_SEQ_1", "euler_SEQ_2", "euler_SEQ_3")
+    + _W_COLS
+    + _A_COLS
+    + ("sigma_attitude_deg", "sigma_omega")
+    + _SW_COLS
+    + ("sigma_axis_deg",)
 )
 _FIXED_COLS = frozenset(c for c in CSV_COLUMNS if "SEQ" not in c)
 
@@ -240,8 +246,18 @@ class Observations:
             ``principal_axes`` when it is not None. Arrays are writable copies.
         """
         out = {}
-        for name in ("t", "attitude", "attitude_sigma", "omega", "omega_sigma", "omega_frame", "axis",
-                     "axis_direction", "axis_sigma", "principal_axes"):
+        for name in (
+            "t",
+            "attitude",
+            "attitude_sigma",
+            "omega",
+            "omega_sigma",
+            "omega_frame",
+            "axis",
+            "axis_direction",
+            "axis_sigma",
+            "principal_axes",
+        ):
             v = getattr(self, name)
             if v is None:
                 continue
@@ -419,8 +435,9 @@ def _read_csv(p: Path, shown: str) -> _Raw:
         with open(p, encoding="utf-8-sig") as fh:  # universal newlines: the text has "\n" only
             text = fh.read()
     except UnicodeDecodeError as exc:
-        raise InvalidInputError(f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); "
-                                "a CSV observations file must be UTF-8") from None
+        raise InvalidInputError(
+            f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); a CSV observations file must be UTF-8"
+        ) from None
     except OSError as exc:
         raise InvalidInputError(f"{shown}: cannot read the file: {exc.strerror or exc}") from None
 
@@ -447,8 +464,9 @@ def _read_csv(p: Path, shown: str) -> _Raw:
         rows.append(fields)
         lines.append(lineno)
     if header is None:
-        raise InvalidInputError(f"{shown}: no header row (the file is empty or only comments); "
-                                f"columns: {', '.join(CSV_COLUMNS)}")
+        raise InvalidInputError(
+            f"{shown}: no header row (the file is empty or only comments); columns: {', '.join(CSV_COLUMNS)}"
+        )
 
     # --- the header
     index: dict[str, int] = {}
@@ -503,7 +521,7 @@ def _read_csv(p: Path, shown: str) -> _Raw:
             f"{shown}: Euler angles in more than one sequence ({', '.join(sorted(euler))}); give one attitude"
         )
     if euler:
-        (seq, parts), = euler.items()
+        ((seq, parts),) = euler.items()
         cols = tuple(f"euler_{seq}_{k}" for k in (1, 2, 3))
         group(cols, f"the Euler angles in sequence {seq!r}")
         from ..attitude.core import parse_seq
@@ -524,9 +542,12 @@ def _read_csv(p: Path, shown: str) -> _Raw:
         )
     if "sigma_omega" in index and has_sw:
         raise InvalidInputError(f"{shown}: both sigma_omega and sigma_wx, sigma_wy, sigma_wz; give one of them")
-    for cols, needs, has in ((("sigma_attitude_deg",), "an attitude (qw..qz or euler_SEQ_*)", has_q or seq),
-                             (("sigma_omega",), "wx, wy, wz", has_w), (_SW_COLS, "wx, wy, wz", has_w),
-                             (("sigma_axis_deg",), "ax, ay, az", has_a)):
+    for cols, needs, has in (
+        (("sigma_attitude_deg",), "an attitude (qw..qz or euler_SEQ_*)", has_q or seq),
+        (("sigma_omega",), "wx, wy, wz", has_w),
+        (_SW_COLS, "wx, wy, wz", has_w),
+        (("sigma_axis_deg",), "ax, ay, az", has_a),
+    ):
         if cols[0] in index and not has:
             raise InvalidInputError(f"{shown}: column {cols[0]} without {needs}: a sigma needs its observation")
     if not rows:
@@ -549,11 +570,13 @@ def _read_csv(p: Path, shown: str) -> _Raw:
         return out
 
     def block(cols, what, scale=1.0, unit=""):
-        return _Block(np.stack([column(c) for c in cols], axis=1), tuple(f"column {c!r}" for c in cols),
-                      what, scale, unit)
+        return _Block(
+            np.stack([column(c) for c in cols], axis=1), tuple(f"column {c!r}" for c in cols), what, scale, unit
+        )
 
-    raw = _Raw(file=shown, places=[f"line {k}" for k in lines], t=column("t"), t_label="column 't'",
-               ignored=tuple(ignored))
+    raw = _Raw(
+        file=shown, places=[f"line {k}" for k in lines], t=column("t"), t_label="column 't'", ignored=tuple(ignored)
+    )
     if has_q:
         raw.attitude = block(_Q_COLS, "columns qw, qx, qy, qz")
     if seq is not None:
@@ -629,8 +652,9 @@ def _read_netcdf(p: Path, shown: str) -> _Raw:
             raise InvalidInputError(
                 f"{shown}: variable {name!r} must have dimensions (t, {k}), got {var.dims} with shape {var.shape}"
             )
-        return _Block(numeric(name, var), tuple(f"variable {name!r} component {c}" for c in range(k)),
-                      f"variable {name!r}")
+        return _Block(
+            numeric(name, var), tuple(f"variable {name!r} component {c}" for c in range(k)), f"variable {name!r}"
+        )
 
     def angle_scale(name, var) -> tuple[float, str]:
         units = var.attrs.get("units")
@@ -658,11 +682,13 @@ def _read_netcdf(p: Path, shown: str) -> _Raw:
         vals = numeric(name, var)
         if vals.ndim == 1:
             return _Block(vals[:, None], (f"variable {name!r}",), f"variable {name!r}", scale, unit)
-        return _Block(vals, tuple(f"variable {name!r} component {c}" for c in range(3)), f"variable {name!r}",
-                      scale, unit)
+        return _Block(
+            vals, tuple(f"variable {name!r} component {c}" for c in range(3)), f"variable {name!r}", scale, unit
+        )
 
-    raw = _Raw(file=shown, places=[f"t index {i}" for i in range(n)], t=t, t_label="coordinate 't'",
-               ignored=tuple(ignored))
+    raw = _Raw(
+        file=shown, places=[f"t index {i}" for i in range(n)], t=t, t_label="coordinate 't'", ignored=tuple(ignored)
+    )
     qname = one_of(_NC_ATTITUDE)
     if qname:
         raw.attitude = vector(qname, 4)
@@ -673,8 +699,9 @@ def _read_netcdf(p: Path, shown: str) -> _Raw:
     if "axis_direction" in ds.data_vars:
         raw.axis_direction = vector("axis_direction", 3)
         if "axis" in ds["axis_direction"].attrs:
-            raw.axis = _unit_axis(ds["axis_direction"].attrs["axis"], f"{shown}: attribute 'axis' of variable "
-                                  "'axis_direction'")
+            raw.axis = _unit_axis(
+                ds["axis_direction"].attrs["axis"], f"{shown}: attribute 'axis' of variable 'axis_direction'"
+            )
     if raw.attitude is None and raw.omega is None and raw.axis_direction is None:
         raise InvalidInputError(
             f"{shown}: no observation variables; give at least one of q (or attitude), omega, axis_direction"
@@ -706,8 +733,9 @@ def _check_times(raw: _Raw) -> np.ndarray:
     if bad.any():
         i = int(np.argmax(bad))
         what = "missing" if np.isnan(t[i]) else f"{float(t[i])!r}, not finite"
-        raise InvalidInputError(f"{raw.file}, {raw.places[i]}, {raw.t_label}: the time is {what}; "
-                                "every row needs a finite time")
+        raise InvalidInputError(
+            f"{raw.file}, {raw.places[i]}, {raw.t_label}: the time is {what}; every row needs a finite time"
+        )
     d = np.diff(t)
     bad = ~(d > 0)
     if bad.any():
@@ -766,8 +794,9 @@ def _unit_rows(raw: _Raw, b: _Block, what: str, noun: str) -> np.ndarray:
             j = int(np.argmax(bad))
             i = int(np.flatnonzero(full)[j])
             if norm[j] == 0:
-                raise InvalidInputError(f"{raw.file}, {raw.places[i]}: {what} is the zero vector ({b.what}); "
-                                        f"a {noun} must have norm 1")
+                raise InvalidInputError(
+                    f"{raw.file}, {raw.places[i]}: {what} is the zero vector ({b.what}); a {noun} must have norm 1"
+                )
             raise InvalidInputError(
                 f"{raw.file}, {raw.places[i]}: {what} {v[i].tolist()} has norm {norm[j]:.10g}, not 1 "
                 f"(tolerance {UNIT_TOLERANCE:g}); a {noun} must have norm 1 ({b.what})"
@@ -840,11 +869,17 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
         """How ``key`` was set: ``omega_frame='space'`` or ``obs.toml: [observations] omega_frame = 'space'``."""
         return f"{origin[key]} = {value}" if key in origin else f"{key}={value}"
 
-    for key, has in (("sigma_attitude_deg", attitude is not None), ("sigma_omega", omega is not None),
-                     ("sigma_axis_deg", axis_direction is not None)):
+    for key, has in (
+        ("sigma_attitude_deg", attitude is not None),
+        ("sigma_omega", omega is not None),
+        ("sigma_axis_deg", axis_direction is not None),
+    ):
         if getattr(s, key) is not None and not has:
-            obs = {"sigma_attitude_deg": "attitude", "sigma_omega": "angular velocity",
-                   "sigma_axis_deg": "axis direction"}[key]
+            obs = {
+                "sigma_attitude_deg": "attitude",
+                "sigma_omega": "angular velocity",
+                "sigma_axis_deg": "axis direction",
+            }[key]
             raise InvalidInputError(f"{said(key, repr(getattr(s, key)))} is given, but {raw.file} has no {obs}")
 
     if raw.omega_frame is not None and s.omega_frame is not None and raw.omega_frame != s.omega_frame:
@@ -856,8 +891,11 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
 
     axis = None
     if raw.axis_direction is not None and axis_direction is not None:  # (the one is read from the other)
-        if raw.axis is not None and s.axis is not None and not np.allclose(raw.axis, s.axis, rtol=0,
-                                                                           atol=UNIT_TOLERANCE):
+        if (
+            raw.axis is not None
+            and s.axis is not None
+            and not np.allclose(raw.axis, s.axis, rtol=0, atol=UNIT_TOLERANCE)
+        ):
             raise InvalidInputError(
                 f"{said('axis', s.axis.tolist())} contradicts {raw.file}, where axis_direction has "
                 f"axis = {raw.axis.tolist()}"
@@ -902,18 +940,33 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
             axis_sigma = _sigma(raw, raw.axis_sigma, np.isfinite(axis_direction[:, 0]))
 
     return Observations(
-        t=_frozen(t), attitude=_frozen(attitude), attitude_sigma=_frozen(attitude_sigma), omega=_frozen(omega),
-        omega_sigma=_frozen(omega_sigma), omega_frame=frame, axis=_frozen(axis),
-        axis_direction=_frozen(axis_direction), axis_sigma=_frozen(axis_sigma), principal_axes=principal,
-        source=source, ignored=raw.ignored,
+        t=_frozen(t),
+        attitude=_frozen(attitude),
+        attitude_sigma=_frozen(attitude_sigma),
+        omega=_frozen(omega),
+        omega_sigma=_frozen(omega_sigma),
+        omega_frame=frame,
+        axis=_frozen(axis),
+        axis_direction=_frozen(axis_direction),
+        axis_sigma=_frozen(axis_sigma),
+        principal_axes=principal,
+        source=source,
+        ignored=raw.ignored,
     )
 
 
 # ---------------------------------------------------------------------------
 # the entry point
 # ---------------------------------------------------------------------------
-def read_observations(path: str | os.PathLike[str], *, sigma_attitude_deg: float | None = None, sigma_omega: float | None = None, sigma_axis_deg: float | None = None, omega_frame: str | None = None,
-                      axis: ArrayLike | None = None) -> Observations:
+def read_observations(
+    path: str | os.PathLike[str],
+    *,
+    sigma_attitude_deg: float | None = None,
+    sigma_omega: float | None = None,
+    sigma_axis_deg: float | None = None,
+    omega_frame: str | None = None,
+    axis: ArrayLike | None = None,
+) -> Observations:
     """Read an observations file (``.csv``, ``.nc`` or ``.toml``; see the module notes for the columns).
 
     Parameters

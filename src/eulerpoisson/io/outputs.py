@@ -114,7 +114,9 @@ def check_output(path, writes: str, *, overwrite: bool = False, inputs=(), flag:
     if have is None:
         return
     if have == "folder":
-        raise OutputError(f"cannot write {path}: it is an existing directory, not a store of ours (--overwrite never replaces it)")
+        raise OutputError(
+            f"cannot write {path}: it is an existing directory, not a store of ours (--overwrite never replaces it)"
+        )
     if not overwrite:
         raise OutputError(f"{path} exists; run again with {flag} to replace it")
     compatible = {
@@ -124,12 +126,19 @@ def check_output(path, writes: str, *, overwrite: bool = False, inputs=(), flag:
         "file": ("file",),
     }[writes]
     if have not in compatible:
-        what = {"netcdf": "a NetCDF file", "trajectory-store": "a trajectory store (.zarr)",
-                "sweep-store": "a sweep store (.zarr)", "zarr": "a Zarr store that is not ours",
-                "folder": "a folder", "file": "a file that is not NetCDF"}[have]
-        raise OutputError(f"refusing to replace {path}: it is {what}, and this command writes "
-                          f"{ {'netcdf': 'a NetCDF file', 'trajectory-store': 'a trajectory store', 'sweep-store': 'a sweep store', 'file': 'a plain file'}[writes] } "
-                          f"({flag} replaces only an output of the same kind)")
+        what = {
+            "netcdf": "a NetCDF file",
+            "trajectory-store": "a trajectory store (.zarr)",
+            "sweep-store": "a sweep store (.zarr)",
+            "zarr": "a Zarr store that is not ours",
+            "folder": "a folder",
+            "file": "a file that is not NetCDF",
+        }[have]
+        raise OutputError(
+            f"refusing to replace {path}: it is {what}, and this command writes "
+            f"{ {'netcdf': 'a NetCDF file', 'trajectory-store': 'a trajectory store', 'sweep-store': 'a sweep store', 'file': 'a plain file'}[writes] } "
+            f"({flag} replaces only an output of the same kind)"
+        )
 
 
 def pid_alive(pid: int) -> bool:
@@ -179,8 +188,10 @@ class OutputLock:
                 except (OSError, ValueError):
                     pid = 0
                 if pid and pid != os.getpid() and pid_alive(pid):
-                    raise OutputError(f"{self.path} is being written by another process (pid {pid}); wait for it "
-                                      f"to finish, or write to another file") from None
+                    raise OutputError(
+                        f"{self.path} is being written by another process (pid {pid}); wait for it "
+                        f"to finish, or write to another file"
+                    ) from None
                 with contextlib.suppress(OSError):
                     self.lock.unlink()  # stale: its process is gone
         raise OutputError(f"cannot lock {self.path} ({self.lock} keeps coming back)")
@@ -191,4 +202,3 @@ class OutputLock:
             self._fd = None
             with contextlib.suppress(OSError):
                 self.lock.unlink()
-

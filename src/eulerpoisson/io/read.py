@@ -161,7 +161,7 @@ def _time_grid(attrs, T: int, first: float, last: float):
     if n != T:
         return None
     g = TimeGrid(t0, t1, n)
-    if float(g[0:1][0]) != first or float(g[n - 1:n][0]) != last:
+    if float(g[0:1][0]) != first or float(g[n - 1 : n][0]) != last:
         return None
     return g
 
@@ -183,7 +183,7 @@ def _zstd_content_size(raw) -> int | None:
     size = (1 if single else 0, 2, 4, 8)[fcs_flag]
     if size == 0 or len(raw) < pos + size:
         return None
-    value = int.from_bytes(bytes(raw[pos:pos + size]), "little")
+    value = int.from_bytes(bytes(raw[pos : pos + size]), "little")
     return value + 256 if size == 2 else value
 
 
@@ -250,8 +250,12 @@ class _DirectChunks:
             endian = getattr(codecs[0].endian, "value", codecs[0].endian)
             dtype = dtype.newbyteorder(">" if endian == "big" else "<")
             shape, chunks = tuple(arr.shape), tuple(arr.chunks)
-            if len(shape) != len(chunks) or not 0 <= axis < len(shape) or not all(
-                    c == s for i, (c, s) in enumerate(zip(chunks, shape)) if i != axis) or chunks[axis] < 1:
+            if (
+                len(shape) != len(chunks)
+                or not 0 <= axis < len(shape)
+                or not all(c == s for i, (c, s) in enumerate(zip(chunks, shape)) if i != axis)
+                or chunks[axis] < 1
+            ):
                 return None
             root = Path(str(arr.store.root)) / str(arr.path)
             if not root.is_dir():
@@ -284,8 +288,12 @@ class _DirectChunks:
             from numcodecs.zstd import decompress
 
             try:
-                if (out is not None and self.dtype.isnative and out.flags.c_contiguous
-                        and _zstd_content_size(raw) == self.nbytes == out.nbytes):
+                if (
+                    out is not None
+                    and self.dtype.isnative
+                    and out.flags.c_contiguous
+                    and _zstd_content_size(raw) == self.nbytes == out.nbytes
+                ):
                     decompress(raw, out)
                     return out
                 raw = memoryview(decompress(raw))
@@ -309,8 +317,13 @@ class _DirectChunks:
         n = len(idx)
         shape = list(self.shape)
         shape[ax] = n
-        if not (isinstance(out, np.ndarray) and out.shape == tuple(shape) and out.dtype == self.native
-                and out.flags.c_contiguous and out.flags.writeable):
+        if not (
+            isinstance(out, np.ndarray)
+            and out.shape == tuple(shape)
+            and out.dtype == self.native
+            and out.flags.c_contiguous
+            and out.flags.writeable
+        ):
             out = np.empty(shape, self.native)
         if n == 0:
             return out
@@ -377,7 +390,9 @@ class StoredArray:
         self.dtype = np.dtype(arr.dtype)
         self.ndim = len(self.shape)
         self.chunks = tuple(getattr(arr, "chunks", shp))
-        self._direct: _DirectChunks | Literal[False] | None = None  # the direct chunk reader (False: zarr reads everything)
+        self._direct: _DirectChunks | Literal[False] | None = (
+            None  # the direct chunk reader (False: zarr reads everything)
+        )
 
     def __len__(self) -> int:
         return self.shape[0]
@@ -547,7 +562,9 @@ class LazyTrajectory:
         ds.attrs = attrs
         bshape = json_attr(path, ds, "batch_shape", "[]", list)
         if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
-            raise InvalidInputError(f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}")
+            raise InvalidInputError(
+                f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}"
+            )
         self.batch_shape = tuple(bshape)
         self.options = json_attr(path, ds, "method_options", "{}", dict)
         self.stats = json_attr(path, ds, "stats", "{}", dict)
@@ -644,8 +661,9 @@ class LazyTrajectory:
             )
         return Trajectory(t, q, w, self.body, self.method, self.options, self.stats, torque=list(self.model.torques))
 
-    def read_arrays(self, names: Iterable[str], a: int = 0, b: int | None = None, step: int = 1, *,
-                    scratch: dict | None = None) -> dict[str, NDArray[np.float64]]:
+    def read_arrays(
+        self, names: Iterable[str], a: int = 0, b: int | None = None, step: int = 1, *, scratch: dict | None = None
+    ) -> dict[str, NDArray[np.float64]]:
         """The raw arrays ``names`` (``"time"`` and stored variables) at samples ``a:b:step``, without a Trajectory.
 
         The cheapest way through a long store: only the named variables are
@@ -679,15 +697,24 @@ class LazyTrajectory:
             out[nm] = x
         return out
 
-    def iter_arrays(self, names: Iterable[str], size: int | None = None, ranges: Iterable[tuple[int, int]] | None = None) -> Iterator[dict[str, NDArray[np.float64]]]:
+    def iter_arrays(
+        self, names: Iterable[str], size: int | None = None, ranges: Iterable[tuple[int, int]] | None = None
+    ) -> Iterator[dict[str, NDArray[np.float64]]]:
         """:meth:`read_arrays` piece by piece (``size`` samples, whole Zarr chunks; or the given ``(a, b)`` ranges).
 
         The next pieces are read in background threads while the caller works on the current one.
         """
         return self.map_arrays(names, None, size, ranges)
 
-    def map_arrays(self, names: Iterable[str], fn: Callable[[dict[str, NDArray[np.float64]]], Any] | None = None, size: int | None = None, ranges: Iterable[tuple[int, int]] | None = None, workers: int | None = None,
-                   reuse: bool = False) -> Iterator[Any]:
+    def map_arrays(
+        self,
+        names: Iterable[str],
+        fn: Callable[[dict[str, NDArray[np.float64]]], Any] | None = None,
+        size: int | None = None,
+        ranges: Iterable[tuple[int, int]] | None = None,
+        workers: int | None = None,
+        reuse: bool = False,
+    ) -> Iterator[Any]:
         """``fn(piece)`` for the pieces of :meth:`iter_arrays`, in order, each read and computed in a thread.
 
         The chunks are decoded in parallel (numcodecs and NumPy release the
@@ -709,8 +736,11 @@ class LazyTrajectory:
 
     def __getitem__(self, index: Any) -> Trajectory:
         if isinstance(index, slice):
-            return self.read(index.start or 0, index.stop, index.step or 1) if (index.step or 1) > 0 else \
-                self.load()[index]
+            return (
+                self.read(index.start or 0, index.stop, index.step or 1)
+                if (index.step or 1) > 0
+                else self.load()[index]
+            )
         if isinstance(index, (int, np.integer)) and not isinstance(index, (bool, np.bool_)):
             i = int(index) + (self.T if index < 0 else 0)
             if not 0 <= i < self.T:
@@ -753,8 +783,16 @@ class LazyTrajectory:
         w = np.concatenate([p[2] for p in parts], axis=-2)
         inv = np.empty_like(order)
         inv[order] = np.arange(order.size)
-        return Trajectory(t[inv], q[..., inv, :], w[..., inv, :], self.body, self.method, self.options, self.stats,
-                          torque=list(self.model.torques))
+        return Trajectory(
+            t[inv],
+            q[..., inv, :],
+            w[..., inv, :],
+            self.body,
+            self.method,
+            self.options,
+            self.stats,
+            torque=list(self.model.torques),
+        )
 
     def head(self, n: int = 1) -> Trajectory:
         """The first ``n`` samples (a Trajectory)."""
@@ -802,9 +840,14 @@ class LazyTrajectory:
         if self.T == 0:
             raise InvalidInputError("drift of a store with no output times")
         h, tl = self.head(), self.tail()
-        both = Trajectory(np.concatenate([h.t, tl.t]), np.concatenate([h.quaternion, tl.quaternion], axis=-2),
-                          np.concatenate([h.omega, tl.omega], axis=-2), self.body, self.method,
-                          torque=list(self.model.torques))
+        both = Trajectory(
+            np.concatenate([h.t, tl.t]),
+            np.concatenate([h.quaternion, tl.quaternion], axis=-2),
+            np.concatenate([h.omega, tl.omega], axis=-2),
+            self.body,
+            self.method,
+            torque=list(self.model.torques),
+        )
         return both.drift()
 
     def plot(self, kind: str = "omega", **kwargs: Any) -> Figure:

@@ -411,8 +411,14 @@ def _rotate_z(v, phi) -> np.ndarray:
     """Space vectors ``v`` (..., 3) rotated by ``phi`` (...) about z."""
     v = np.asarray(v, dtype=float)
     c, s = np.cos(phi), np.sin(phi)
-    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1],
-                     np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, np.shape(c)))], -1)
+    return np.stack(
+        [
+            c * v[..., 0] - s * v[..., 1],
+            s * v[..., 0] + c * v[..., 1],
+            np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, np.shape(c))),
+        ],
+        -1,
+    )
 
 
 def _shifted_torques(torques, t_start: float):
@@ -469,7 +475,17 @@ def _shifted_torques(torques, t_start: float):
     return out, phi
 
 
-def solve_from(model: Model | RigidBody | ArrayLike, t: ArrayLike, t_start: float, q_start: ArrayLike, omega_start: ArrayLike, *, method: str, workers: int | None = None, **options: Any) -> Trajectory:
+def solve_from(
+    model: Model | RigidBody | ArrayLike,
+    t: ArrayLike,
+    t_start: float,
+    q_start: ArrayLike,
+    omega_start: ArrayLike,
+    *,
+    method: str,
+    workers: int | None = None,
+    **options: Any,
+) -> Trajectory:
     r"""Continue a motion from its state at ``t_start`` to the (absolute) output times ``t``.
 
     The building block of long runs solved chunk by chunk: the model is
@@ -509,8 +525,7 @@ def solve_from(model: Model | RigidBody | ArrayLike, t: ArrayLike, t_start: floa
     t = np.asarray(t, dtype=float)
     t_start = float(t_start)
     if model.is_autonomous or t_start == 0.0:
-        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, workers=workers,
-                   **options)
+        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, workers=workers, **options)
         tr.t = t
         return tr
     torques, phi = _shifted_torques(model.torques, t_start)
@@ -519,8 +534,15 @@ def solve_from(model: Model | RigidBody | ArrayLike, t: ArrayLike, t_start: floa
     if turned:
         rz = _rotation_z(phi)
         q_start = qmul(rz * np.array([1.0, -1.0, -1.0, -1.0]), q_start)
-    tr = solve(Model(model.body, torques), t - t_start, omega0=omega_start, attitude0=q_start, method=method,
-               workers=workers, **options)
+    tr = solve(
+        Model(model.body, torques),
+        t - t_start,
+        omega0=omega_start,
+        attitude0=q_start,
+        method=method,
+        workers=workers,
+        **options,
+    )
     q = tr.quaternion
     if turned:
         q = qmul(_rotation_z(phi)[..., None, :], q)
@@ -551,7 +573,7 @@ def _chunk_arrays(traj, variables) -> dict[str, np.ndarray]:
 def _flatten_batch(a: np.ndarray, bshape: tuple) -> np.ndarray:
     if not bshape:
         return a
-    return a.reshape((int(np.prod(bshape)),) + a.shape[len(bshape):])
+    return a.reshape((int(np.prod(bshape)),) + a.shape[len(bshape) :])
 
 
 def solve_to_file(
@@ -775,7 +797,11 @@ def solve_to_file(
                 kind = v.dtype.kind
                 fill = np.nan if kind == "f" else ("" if kind == "U" else 0)
                 arr = g.create_array(
-                    name, shape=tuple(shape), chunks=tuple(chunks), dtype=v.dtype, fill_value=fill,
+                    name,
+                    shape=tuple(shape),
+                    chunks=tuple(chunks),
+                    dtype=v.dtype,
+                    fill_value=fill,
                     dimension_names=dims,
                 )
                 arr.attrs.update(dict(v.attrs))
@@ -821,8 +847,15 @@ def solve_to_file(
                     _check_monotonic(tc, prev_t, a, direction)
                 start = _time.perf_counter()
                 if closed_form or prev_q is None:
-                    tr = solve(model, tc, omega0=problem.omega0, attitude0=problem.q0, method=method,
-                               workers=workers, **options)
+                    tr = solve(
+                        model,
+                        tc,
+                        omega0=problem.omega0,
+                        attitude0=problem.q0,
+                        method=method,
+                        workers=workers,
+                        **options,
+                    )
                 else:
                     assert prev_t is not None and prev_w is not None  # set with prev_q
                     tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, workers=workers, **options)
@@ -838,11 +871,14 @@ def solve_to_file(
                     for name, arr in arrays.items():
                         arr[tslice(a, b)] = _flatten_batch(data[name], bshape)
                     tarr[a:b] = tc
-                counters = {key: val for key, val in tr.stats.items()
-                            if isinstance(val, numbers.Number) and not isinstance(val, bool)
-                            and key not in ("wall_time", "threads")}
-                _mark_done(work, k, {"wall_time": wall, "stats": counters,
-                                     "written": datetime.now(UTC).isoformat()})
+                counters = {
+                    key: val
+                    for key, val in tr.stats.items()
+                    if isinstance(val, numbers.Number)
+                    and not isinstance(val, bool)
+                    and key not in ("wall_time", "threads")
+                }
+                _mark_done(work, k, {"wall_time": wall, "stats": counters, "written": datetime.now(UTC).isoformat()})
                 prev_q = q[..., -1, :]
                 prev_w = tr.omega[..., -1, :]
                 prev_t = float(tc[-1])
@@ -850,8 +886,7 @@ def solve_to_file(
                 bar.update(n_done)
     except KeyboardInterrupt as exc:
         exc.add_note(
-            f"eulerpoisson: the finished chunks of {path} are kept in {store}; "
-            "rerun with resume=True to continue"
+            f"eulerpoisson: the finished chunks of {path} are kept in {store}; rerun with resume=True to continue"
         )
         raise
 
@@ -868,13 +903,15 @@ def solve_to_file(
         for key, val in info.get("stats", {}).items():
             totals[key] = totals.get(key, 0) + val
     with _quiet_zarr():
-        g.attrs.update({
-            "stats": json.dumps(totals, default=float, sort_keys=True),
-            "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} streamed by "
-            f"eulerpoisson {template.attrs['eulerpoisson_version']} in {nchunks} chunks of {chunk}",
-            # the arguments of the run: a later resume=True with the same ones finds it complete
-            "eulerpoisson_run": json.dumps(fingerprint, sort_keys=True, default=float),
-        })
+        g.attrs.update(
+            {
+                "stats": json.dumps(totals, default=float, sort_keys=True),
+                "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} streamed by "
+                f"eulerpoisson {template.attrs['eulerpoisson_version']} in {nchunks} chunks of {chunk}",
+                # the arguments of the run: a later resume=True with the same ones finds it complete
+                "eulerpoisson_run": json.dumps(fingerprint, sort_keys=True, default=float),
+            }
+        )
         zarr.consolidate_metadata(str(store))
     _replace_dir(store, path, overwrite)
     shutil.rmtree(work, ignore_errors=True)

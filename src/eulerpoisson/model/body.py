@@ -47,7 +47,7 @@ EXP_SAFE = 500
 def _check_not_empty(a: np.ndarray, name: str, tail: int) -> None:
     if a.size == 0:
         raise InvalidInputError(
-            f"{name} is an empty batch of shape {a.shape} (batch shape {a.shape[:a.ndim - tail]}); "
+            f"{name} is an empty batch of shape {a.shape} (batch shape {a.shape[: a.ndim - tail]}); "
             "at least one body is needed"
         )
 
@@ -124,7 +124,9 @@ def check_moments(ev: np.ndarray, name: str = "inertia", triangle: bool = True) 
         )
 
 
-def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _principal_from_moments(
+    a: np.ndarray, name: str, triangle: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     check_moments(a, name, triangle)
     ev = a.copy()
     I = ev[..., :, None] * np.eye(3)
@@ -132,7 +134,9 @@ def _principal_from_moments(a: np.ndarray, name: str, triangle: bool = True) -> 
     return I, ev, P
 
 
-def _principal_from_tensor(a: np.ndarray, name: str, triangle: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _principal_from_tensor(
+    a: np.ndarray, name: str, triangle: bool = True
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     check_tensor(a, name)
     # very large or very small tensors are scaled by a power of two (exact) so that neither the
     # symmetrization nor the eigen-decomposition overflows or underflows; ordinary ones are untouched
@@ -334,9 +338,7 @@ class RigidBody:
                 f"masses must have shape (N,) and positions (N, 3) with the same N; got {m.shape} and {x.shape}"
             )
         if m.shape[0] < 3:
-            raise InvalidInputError(
-                f"a rigid body needs at least three non-collinear masses, got {m.shape[0]}"
-            )
+            raise InvalidInputError(f"a rigid body needs at least three non-collinear masses, got {m.shape[0]}")
         if np.any(m <= 0):
             raise InvalidInputError(f"masses must all be > 0, got {describe_value(m)}")
         # The inertia is homogeneous, I(s x, mu m) = mu s^2 I(x, m): masses and positions are scaled
@@ -363,8 +365,10 @@ class RigidBody:
             I = np.ldexp(Is, em + 2 * ex)
             ev_s = np.linalg.eigvalsh(Is)
             ev = np.ldexp(ev_s, em + 2 * ex)
-        sizes = (f"masses up to {np.max(m):.6g} and positions relative to the centre of mass up to "
-                 f"{np.ldexp(scale, ex):.6g} in absolute value")
+        sizes = (
+            f"masses up to {np.max(m):.6g} and positions relative to the centre of mass up to "
+            f"{np.ldexp(scale, ex):.6g} in absolute value"
+        )
         if not (np.all(np.isfinite(I)) and np.all(np.isfinite(ev)) and np.all(np.isfinite(xr))):
             raise InvalidInputError(
                 f"the inertia tensor of these particles overflows float64 ({sizes}): "
@@ -551,7 +555,9 @@ class RigidBody:
         with np.errstate(over="ignore", invalid="ignore"):
             E = 0.5 * np.sum(w * self.angular_momentum(w), -1)
         if not np.all(np.isfinite(E)):
-            raise InvalidInputError(f"energy overflows float64 (max |omega| = {float(np.max(np.abs(w))):.3g}); rescale omega")
+            raise InvalidInputError(
+                f"energy overflows float64 (max |omega| = {float(np.max(np.abs(w))):.3g}); rescale omega"
+            )
         return E
 
     def to_principal(self, v: ArrayLike) -> NDArray[np.float64]:

@@ -171,7 +171,7 @@ class Model:
 
         def sub(shape):
             k = len(shape)
-            tail = index[len(index) - k:] if k else ()
+            tail = index[len(index) - k :] if k else ()
             return tuple(0 if n == 1 else i for i, n in zip(tail, shape))
 
         body = self.body[sub(self.body.batch_shape)] if self.body.batch_shape else self.body
@@ -235,8 +235,12 @@ class Model:
         q = np.asarray(q, dtype=float)
         omega = np.asarray(omega, dtype=float)
         zero = np.zeros_like(omega[..., 0])
-        qd = 0.5 * np.stack(qmul_components(q[..., 0], q[..., 1], q[..., 2], q[..., 3],
-                                            zero, omega[..., 0], omega[..., 1], omega[..., 2]), -1)
+        qd = 0.5 * np.stack(
+            qmul_components(
+                q[..., 0], q[..., 1], q[..., 2], q[..., 3], zero, omega[..., 0], omega[..., 1], omega[..., 2]
+            ),
+            -1,
+        )
         return qd, self.omega_dot(t, q, omega)
 
     def polynomial(self) -> PolynomialTorque | None:
@@ -338,7 +342,11 @@ class Model:
         tol = SYMMETRY_RTOL * np.max(ev, axis=-1)
         chat = c / cn[..., None]
         # explicit sums of three terms: no reduction whose order could depend on the batch
-        Ic = inertia[..., 0] * chat[..., 0, None] + inertia[..., 1] * chat[..., 1, None] + inertia[..., 2] * chat[..., 2, None]
+        Ic = (
+            inertia[..., 0] * chat[..., 0, None]
+            + inertia[..., 1] * chat[..., 1, None]
+            + inertia[..., 2] * chat[..., 2, None]
+        )
         C = chat[..., 0] * Ic[..., 0] + chat[..., 1] * Ic[..., 1] + chat[..., 2] * Ic[..., 2]
         d = Ic - C[..., None] * chat
         # the centre of mass must lie on an eigenvector whose eigenvalue is simple or the body a sphere,
@@ -356,7 +364,11 @@ class Model:
         from_axes = np.take_along_axis(P, j[..., None, None], axis=-1)[..., 0]
         from_eye = np.eye(3)[np.argmin(np.abs(chat), axis=-1)]
         trial = np.where((np.ptp(ev, axis=-1) > tol)[..., None], from_axes, from_eye)
-        e1 = trial - (trial[..., 0] * chat[..., 0] + trial[..., 1] * chat[..., 1] + trial[..., 2] * chat[..., 2])[..., None] * chat
+        e1 = (
+            trial
+            - (trial[..., 0] * chat[..., 0] + trial[..., 1] * chat[..., 1] + trial[..., 2] * chat[..., 2])[..., None]
+            * chat
+        )
         e1 = e1 / np.sqrt(e1[..., 0] ** 2 + e1[..., 1] ** 2 + e1[..., 2] ** 2)[..., None]
         e2 = np.cross(chat, e1)
         F = np.stack([e1, e2, chat], axis=-1)
@@ -410,7 +422,7 @@ class Model:
 
         def per_body(a, tail):
             a = np.asarray(a, dtype=float)
-            return a.reshape(a.shape[: a.ndim - tail] + (1,) + a.shape[a.ndim - tail:])
+            return a.reshape(a.shape[: a.ndim - tail] + (1,) + a.shape[a.ndim - tail :])
 
         inertia = per_body(self.body.inertia, 2)
         # the same expressions as Trajectory.M, .m and .energy (so that the drifts agree to the last bit)
@@ -447,14 +459,17 @@ class Model:
                 w = _mv(F.T, omega)
                 gamma = -_mv(F.T, np.einsum("...ji,j->...i", R, gh1))
                 if key == "kovalevskaya":
-                    val = (w[..., 0] + 1j * w[..., 1]) ** 2 - kappa * (c2[0] + 1j * c2[1]) * (gamma[..., 0] + 1j * gamma[..., 1])
+                    val = (w[..., 0] + 1j * w[..., 1]) ** 2 - kappa * (c2[0] + 1j * c2[1]) * (
+                        gamma[..., 0] + 1j * gamma[..., 1]
+                    )
                     out[key] = (val * np.conj(val)).real
                 else:
                     area = out["m_vertical"]
                     scale = float(np.sqrt(np.max(_dot(m, m)))) if m.size else 0.0
                     if area.size and np.all(np.abs(area[..., 0]) <= 1e-12 * max(scale, 1e-300)):
-                        out[key] = (w[..., 2] * (w[..., 0] ** 2 + w[..., 1] ** 2)
-                                    - kappa * gamma[..., 2] * (c2[0] * w[..., 0] + c2[1] * w[..., 1]))
+                        out[key] = w[..., 2] * (w[..., 0] ** 2 + w[..., 1] ** 2) - kappa * gamma[..., 2] * (
+                            c2[0] * w[..., 0] + c2[1] * w[..., 1]
+                        )
             return out
         if kinds == {GravityGradient} and len(self.torques) == 1:
             nu = per_body(cast(GravityGradient, self.torques[0]).mean_motion, 0)

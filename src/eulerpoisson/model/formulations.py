@@ -693,9 +693,7 @@ def _christoffel(n, I, Iinv):
     K = _T(inverse_conversion_matrix(n)) @ Iinv  # Ã^T I^-1
     B = np.einsum("...ia,...jka->...ijk", K, X)
     d = np.eye(3)
-    kin = (n[..., None, :, None] * d[:, None, :] + n[..., None, None, :] * d[:, :, None]) / s[
-        ..., None, None, None
-    ]
+    kin = (n[..., None, :, None] * d[:, None, :] + n[..., None, None, :] * d[:, :, None]) / s[..., None, None, None]
     return -(B + np.swapaxes(B, -1, -2)) - kin
 
 
@@ -723,9 +721,7 @@ def christoffel_from_metric(n: ArrayLike, inertia: ArrayLike, dG: ArrayLike | No
     n = as_float_array(n, "n", (3,))
     body = _as_body(inertia)
     dG = _metric_derivative(n, body.inertia) if dG is None else as_float_array(dG, "dG", (3, 3, 3))
-    first = 0.5 * (
-        np.einsum("...jlk->...ljk", dG) + np.einsum("...klj->...ljk", dG) - dG
-    )  # Γ_{l jk}
+    first = 0.5 * (np.einsum("...jlk->...ljk", dG) + np.einsum("...klj->...ljk", dG) - dG)  # Γ_{l jk}
     Ginv = inverse_metric(n, body.inertia)
     return np.einsum("...il,...ljk->...ijk", Ginv, first)
 
@@ -1007,9 +1003,7 @@ class Formulation:
             Wrong trailing shape or non-finite values.
         """
         x = self._check(state)
-        return {
-            k: x[..., sl].reshape(x.shape[:-1] + self.block_shapes[k]) for k, sl in self.layout.items()
-        }
+        return {k: x[..., sl].reshape(x.shape[:-1] + self.block_shapes[k]) for k, sl in self.layout.items()}
 
     def pack(self, **blocks: ArrayLike) -> NDArray[np.float64]:
         """Assemble a state (..., d) from named blocks (broadcast against each other).
@@ -1744,7 +1738,6 @@ def formulation(name: str, body: RigidBody | ArrayLike, torque: TorqueLike = Non
     key = _ALIASES.get(key, key)
     if key not in FORMULATIONS:
         raise InvalidInputError(
-            f"unknown formulation {name!r}; expected one of {sorted(FORMULATIONS)} "
-            f"or an alias {sorted(_ALIASES)}"
+            f"unknown formulation {name!r}; expected one of {sorted(FORMULATIONS)} or an alias {sorted(_ALIASES)}"
         )
     return FORMULATIONS[key](body, torque)

@@ -226,7 +226,9 @@ class Torque:
         """Batch shape of the parameters (``()`` for one set)."""
         return ()
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         r"""Body-frame torque :math:`\boldsymbol\tau`.
 
         Parameters
@@ -351,12 +353,13 @@ class Gravity(Torque):
     kind = "gravity"
     conservative = True
 
-    def __init__(self, mass: ArrayLike, center_of_mass: ArrayLike, g: ArrayLike = (0.0, 0.0, -STANDARD_GRAVITY)) -> None:
+    def __init__(
+        self, mass: ArrayLike, center_of_mass: ArrayLike, g: ArrayLike = (0.0, 0.0, -STANDARD_GRAVITY)
+    ) -> None:
         self.mass = _scalar_array(mass, "mass", "Gravity", positive=True)
         self.center_of_mass = _vec(center_of_mass, "center_of_mass", "Gravity")
         self.g = _vec(g, "g", "Gravity")
-        self._shape = _shape("Gravity", mass=self.mass, center_of_mass=self.center_of_mass[..., 0],
-                             g=self.g[..., 0])
+        self._shape = _shape("Gravity", mass=self.mass, center_of_mass=self.center_of_mass[..., 0], g=self.g[..., 0])
 
     @property
     def batch_shape(self) -> tuple[int, ...]:
@@ -367,7 +370,9 @@ class Gravity(Torque):
         r""":math:`\mu\mathbf c`, shape (..., 3)."""
         return self.mass[..., None] * self.center_of_mass
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         return np.cross(self.moment_arm, _bT(R, self.g))
 
     def potential(self, t: ArrayLike, R: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -382,16 +387,25 @@ class Gravity(Torque):
         return PolynomialTorque(constant=np.zeros(3), vectors=(self.g,), maps=(L,))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"kind": self.kind, "mass": _plain(self.mass), "center_of_mass": _plain(self.center_of_mass),
-                "g": _plain(self.g)}
+        return {
+            "kind": self.kind,
+            "mass": _plain(self.mass),
+            "center_of_mass": _plain(self.center_of_mass),
+            "g": _plain(self.g),
+        }
 
     def __getitem__(self, idx: Any) -> Gravity:
         b = self._shape
-        return Gravity(np.broadcast_to(self.mass, b)[idx], np.broadcast_to(self.center_of_mass, b + (3,))[idx],
-                       np.broadcast_to(self.g, b + (3,))[idx])
+        return Gravity(
+            np.broadcast_to(self.mass, b)[idx],
+            np.broadcast_to(self.center_of_mass, b + (3,))[idx],
+            np.broadcast_to(self.g, b + (3,))[idx],
+        )
 
     def __repr__(self) -> str:
-        return f"Gravity(mass={_plain(self.mass)!r}, center_of_mass={_plain(self.center_of_mass)!r}, g={_plain(self.g)!r})"
+        return (
+            f"Gravity(mass={_plain(self.mass)!r}, center_of_mass={_plain(self.center_of_mass)!r}, g={_plain(self.g)!r})"
+        )
 
 
 class GravityGradient(Torque):
@@ -448,7 +462,9 @@ class GravityGradient(Torque):
         phase = np.asarray(t, dtype=float) * self.mean_motion
         return np.stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)], -1)
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         r = _bT(R, self.direction(t))
         Ir = np.einsum("...ij,...j->...i", inertia, r)
         return 3.0 * (self.mean_motion**2)[..., None] * np.cross(r, Ir)
@@ -459,8 +475,7 @@ class GravityGradient(Torque):
         return 1.5 * self.mean_motion**2 * np.einsum("...i,...i->...", r, Ir)
 
     def polynomial(self) -> PolynomialTorque:
-        return PolynomialTorque(constant=np.zeros(3), orbit_rate=self.mean_motion,
-                                orbit_gain=3.0 * self.mean_motion**2)
+        return PolynomialTorque(constant=np.zeros(3), orbit_rate=self.mean_motion, orbit_gain=3.0 * self.mean_motion**2)
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "mean_motion": _plain(self.mean_motion)}
@@ -498,7 +513,9 @@ class BodyTorque(Torque):
     def batch_shape(self) -> tuple[int, ...]:
         return self.tau.shape[:-1]
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         return np.broadcast_to(self.tau, np.broadcast_shapes(self.tau.shape, np.shape(omega))).copy()
 
     def polynomial(self) -> PolynomialTorque:
@@ -540,7 +557,9 @@ class SpaceTorque(Torque):
     def batch_shape(self) -> tuple[int, ...]:
         return self.tau.shape[:-1]
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         return _bT(R, self.tau)
 
     def polynomial(self) -> PolynomialTorque:
@@ -598,7 +617,14 @@ class CallableTorque(Torque):
             raise TypeError(f"torque must be a Torque or a callable torque(t, q, omega), got {func!r}")
         self.func = func
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64], q: NDArray[np.float64] | None = None) -> NDArray[np.float64]:
+    def evaluate(
+        self,
+        t: ArrayLike,
+        R: NDArray[np.float64],
+        omega: NDArray[np.float64],
+        inertia: NDArray[np.float64],
+        q: NDArray[np.float64] | None = None,
+    ) -> NDArray[np.float64]:
         if q is None:
             from ..attitude.core import quaternion_from_rotation_matrix
 
@@ -650,7 +676,9 @@ class UnrecordedTorque(Torque):
     def __init__(self, description: str = "") -> None:
         self.description = description
 
-    def evaluate(self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]) -> NDArray[np.float64]:
+    def evaluate(
+        self, t: ArrayLike, R: NDArray[np.float64], omega: NDArray[np.float64], inertia: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
         raise NotImplementedError(f"the torque {self.description} was a Python function and was not saved in the file")
 
     def to_dict(self) -> dict[str, Any]:
@@ -728,4 +756,3 @@ def as_torques(torque: TorqueLike) -> tuple[Torque, ...]:
         f"torque must be a Torque (eulerpoisson.torques.Gravity, GravityGradient, BodyTorque, SpaceTorque), "
         f"a callable torque(t, q, omega) -> tau_body, or a list of them; got {torque!r}"
     )
-

@@ -146,9 +146,7 @@ def _as_float_array(x, name):
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(f"{name} must be a real array_like, got {x!r}") from exc
     if not np.all(np.isfinite(arr)):
-        raise InvalidInputError(
-            f"{name} must be finite; got non-finite values (shape {arr.shape})"
-        )
+        raise InvalidInputError(f"{name} must be finite; got non-finite values (shape {arr.shape})")
     return arr
 
 
@@ -169,9 +167,7 @@ def _parameters(m, m1):
         m1 = _as_float_array(m1, "m1")
         if np.any((m1 < 0.0) | (m1 > 1.0)):
             bad = m1[(m1 < 0.0) | (m1 > 1.0)].ravel()[0].item()
-            raise InvalidInputError(
-                f"complementary parameter m1 = 1 - m must lie in [0, 1], got m1={bad!r}"
-            )
+            raise InvalidInputError(f"complementary parameter m1 = 1 - m must lie in [0, 1], got m1={bad!r}")
     if m is None:
         m = 1.0 - m1
     elif m1 is None:
@@ -179,10 +175,7 @@ def _parameters(m, m1):
     else:
         m, m1 = np.broadcast_arrays(m, m1)
         if np.any(np.abs((m - 1.0) + m1) > 4.0 * _EPS):
-            raise InvalidInputError(
-                "m and m1 were both given but m + m1 != 1 (beyond 4 eps); "
-                "pass only one of them"
-            )
+            raise InvalidInputError("m and m1 were both given but m + m1 != 1 (beyond 4 eps); pass only one of them")
     m, m1 = np.broadcast_arrays(m, m1)
     return np.array(m, dtype=np.float64), np.array(m1, dtype=np.float64)
 
@@ -686,8 +679,12 @@ def _rd_step(st):
     sx, sy, sz = np.sqrt(x), np.sqrt(y), np.sqrt(z)
     lam = sx * sy + sy * sz + sz * sx
     return [
-        0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam),
-        0.25 * (z + lam), acc + fac / (sz * (z + lam)),
+        0.25 * (a + lam),
+        0.25 * fac,
+        0.25 * (x + lam),
+        0.25 * (y + lam),
+        0.25 * (z + lam),
+        acc + fac / (sz * (z + lam)),
     ]
 
 
@@ -731,9 +728,26 @@ def rc1_series(e):
     (``e`` falls by about 64 per step), which saves an ``atan`` (or ``log1p``),
     a square root and a division each.
     """
-    return 1.0 + e * (-1.0 / 3.0 + e * (1.0 / 5.0 + e * (-1.0 / 7.0 + e * (1.0 / 9.0 + e * (
-        -1.0 / 11.0 + e * (1.0 / 13.0 + e * (-1.0 / 15.0 + e * (1.0 / 17.0 + e * (
-            -1.0 / 19.0 + e * (1.0 / 21.0))))))))))
+    return 1.0 + e * (
+        -1.0 / 3.0
+        + e
+        * (
+            1.0 / 5.0
+            + e
+            * (
+                -1.0 / 7.0
+                + e
+                * (
+                    1.0 / 9.0
+                    + e
+                    * (
+                        -1.0 / 11.0
+                        + e * (1.0 / 13.0 + e * (-1.0 / 15.0 + e * (1.0 / 17.0 + e * (-1.0 / 19.0 + e * (1.0 / 21.0)))))
+                    )
+                )
+            )
+        )
+    )
 
 
 def _rc1(e, y):
@@ -797,8 +811,15 @@ def _rj_step(st):
     # avoids the cancellation in 1 + e for p << x, y, z
     y1 = 2.0 * sp * (p + lam) / d
     return [
-        0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam),
-        0.25 * (z + lam), 0.25 * (p + lam), acc + fac * _rc1(e, y1) / d, delta, sc,
+        0.25 * (a + lam),
+        0.25 * fac,
+        0.25 * (x + lam),
+        0.25 * (y + lam),
+        0.25 * (z + lam),
+        0.25 * (p + lam),
+        acc + fac * _rc1(e, y1) / d,
+        delta,
+        sc,
     ]
 
 
@@ -849,8 +870,7 @@ def _rc(x, y):
     a, fac, _, _ = _duplicate(q, [a0, np.ones_like(a0), x, y], _rc_step)
     s = (y - a0) * fac / a
     poly = 1.0 + s * s * (
-        3.0 / 10.0
-        + s * (1.0 / 7.0 + s * (3.0 / 8.0 + s * (9.0 / 22.0 + s * (159.0 / 208.0 + s * 9.0 / 8.0))))
+        3.0 / 10.0 + s * (1.0 / 7.0 + s * (3.0 / 8.0 + s * (9.0 / 22.0 + s * (159.0 / 208.0 + s * 9.0 / 8.0))))
     )
     return (poly / np.sqrt(a)).reshape(shape)
 
@@ -951,15 +971,12 @@ def elliprj(x, y, z, p):
         On negative/non-finite arguments, ``p <= 0`` or two zeros among
         ``x, y, z``.
     """
-    x, y, z, p = (
-        _as_float_array(v, n) for v, n in ((x, "x"), (y, "y"), (z, "z"), (p, "p"))
-    )
+    x, y, z, p = (_as_float_array(v, n) for v, n in ((x, "x"), (y, "y"), (z, "z"), (p, "p")))
     for n, v in (("x", x), ("y", y), ("z", z)):
         _check_nonneg(n, v)
     if np.any(p <= 0.0):
         raise InvalidInputError(
-            f"elliprj: p must be > 0 (principal values are not supported), "
-            f"got p={p[p <= 0.0].ravel()[0].item()!r}"
+            f"elliprj: p must be > 0 (principal values are not supported), got p={p[p <= 0.0].ravel()[0].item()!r}"
         )
     zeros = (x == 0.0).astype(int) + (y == 0.0) + (z == 0.0)
     if np.any(zeros >= 2):
@@ -1078,9 +1095,7 @@ def ellippi_complete(n, m=None, m1=None):
     """
     n = _as_float_array(n, "n")
     if np.any(n >= 1.0):
-        raise InvalidInputError(
-            f"characteristic n must be < 1, got n={n[n >= 1.0].ravel()[0].item()!r}"
-        )
+        raise InvalidInputError(f"characteristic n must be < 1, got n={n[n >= 1.0].ravel()[0].item()!r}")
     m, m1 = _parameters(m, m1)
     kh, _, _ = _ellipk_dd(m1)
     sep = m1 == 0.0
@@ -1126,9 +1141,7 @@ def ellippi(n, phi, m=None, m1=None):
     """
     n = _as_float_array(n, "n")
     if np.any(n >= 1.0):
-        raise InvalidInputError(
-            f"characteristic n must be < 1, got n={n[n >= 1.0].ravel()[0].item()!r}"
-        )
+        raise InvalidInputError(f"characteristic n must be < 1, got n={n[n >= 1.0].ravel()[0].item()!r}")
     phi = _as_float_array(phi, "phi")
     m, m1 = _parameters(m, m1)
     kh, kl, _ = _ellipk_dd(m1)

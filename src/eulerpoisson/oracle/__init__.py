@@ -31,14 +31,37 @@ from .runs import (
 )
 
 __all__ = [
-    "validate", "ValidationReport", "compare_run", "Conventions", "RawRun", "read_run", "run_from_arrays",
-    "normalize_run", "ReferenceCase", "reference_cases", "reference_case", "write_cases", "CASE_NAMES",
-    "plot_report", "QUATERNION_ORDERS", "OMEGA_FRAMES", "ATTITUDE_CONVENTIONS", "NORM_TOLERANCE",
+    "validate",
+    "ValidationReport",
+    "compare_run",
+    "Conventions",
+    "RawRun",
+    "read_run",
+    "run_from_arrays",
+    "normalize_run",
+    "ReferenceCase",
+    "reference_cases",
+    "reference_case",
+    "write_cases",
+    "CASE_NAMES",
+    "plot_report",
+    "QUATERNION_ORDERS",
+    "OMEGA_FRAMES",
+    "ATTITUDE_CONVENTIONS",
+    "NORM_TOLERANCE",
 ]
 
 
-def validate(run: str | os.PathLike[str] | RawRun, inertia: ArrayLike | None = None, *, quaternion_order: str | None = None, omega_frame: str = "body", attitude_convention: str = "body-to-space",
-             tolerance: float | None = None, detect: bool = True) -> ValidationReport:
+def validate(
+    run: str | os.PathLike[str] | RawRun,
+    inertia: ArrayLike | None = None,
+    *,
+    quaternion_order: str | None = None,
+    omega_frame: str = "body",
+    attitude_convention: str = "body-to-space",
+    tolerance: float | None = None,
+    detect: bool = True,
+) -> ValidationReport:
     """Validate a run (a file or a :class:`RawRun`) against the exact free motion from its first sample.
 
     Parameters

@@ -114,10 +114,16 @@ class ReferenceCase:
 
     def to_dict(self) -> dict:
         """Initial state and settings (no samples), JSON-able."""
-        return {"name": self.name, "description": self.description,
-                "inertia": np.array(self.inertia, float).tolist(), "omega0": list(map(float, self.omega0)),
-                "quaternion0": list(map(float, self.quaternion0)), "t_end": float(self.t_end),
-                "samples": int(self.samples), "flips": self.flips}
+        return {
+            "name": self.name,
+            "description": self.description,
+            "inertia": np.array(self.inertia, float).tolist(),
+            "omega0": list(map(float, self.omega0)),
+            "quaternion0": list(map(float, self.quaternion0)),
+            "t_end": float(self.t_end),
+            "samples": int(self.samples),
+            "flips": self.flips,
+        }
 
     def to_csv(self, path: str | os.PathLike[str]) -> None:
         """Write ``t,qw,qx,qy,qz,wx,wy,wz`` with 17 significant digits (round-trips float64)."""
@@ -139,30 +145,103 @@ def _cases() -> list[ReferenceCase]:
     e = 2e-4 / np.sqrt(1.0 - 1e-6)
     q_tilt = tuple(np.array([np.cos(0.35), 0.6 * np.sin(0.35), -0.48 * np.sin(0.35), 0.64 * np.sin(0.35)]).tolist())
     return [
-        ReferenceCase("tennis_racket_circulating_1", "flat racket spun near its intermediate axis; momentum circulates "
-                      "about the axis of the smallest moment (L^2 < 2 E I2); 1 - k^2 = 1e-4", racket,
-                      (0.004, 0.4, 0.0), ident, 200.0, 2001, True),
-        ReferenceCase("tennis_racket_circulating_3", "the same racket on the other side of the separatrix: momentum "
-                      "circulates about the axis of the largest moment (L^2 > 2 E I2); 1 - k^2 = 4e-4", racket,
-                      (0.0, 0.4, 0.004), ident, 200.0, 2001, True),
-        ReferenceCase("tennis_racket_separatrix", "the racket at 1 - k^2 = 1e-6 from the separatrix: flips every "
-                      "82.94 s", racket, (0.0, 0.4, float(e)), ident, 300.0, 3001, True),
-        ReferenceCase("full_tensor", "a full non-diagonal inertia tensor, a tilted initial attitude",
-                      ((2.0, 0.1, 0.0), (0.1, 1.5, -0.2), (0.0, -0.2, 1.2)), (0.7, -1.1, 2.0), q_tilt, 20.0, 2001),
-        ReferenceCase("symmetric_top", "a symmetric top (I1 = I2): a uniform precession", (1.0, 1.0, 1.5),
-                      (0.3, 0.2, 1.0), q_tilt, 30.0, 3001),
-        ReferenceCase("fast_spin", "a fast spin, |Omega| = 100 rad/s, nearly about the axis of the largest moment",
-                      (1.0, 2.0, 3.0), (1.0, 0.5, 100.0), ident, 10.0, 10001),
-        ReferenceCase("long_run", "a long run to t = 1e4", (1.0, 2.0, 3.0), (1.0, 0.1, 0.5), ident, 1.0e4, 10001,
-                      True),
-        ReferenceCase("sphere", "a spherical body: Omega constant, a uniform rotation", (2.0, 2.0, 2.0),
-                      (0.3, -0.4, 1.2), q_tilt, 20.0, 2001),
-        ReferenceCase("principal_axis_1", "the racket spun exactly about its axis of smallest moment (stable)",
-                      racket, (0.5, 0.0, 0.0), ident, 100.0, 1001),
-        ReferenceCase("principal_axis_2", "the racket spun exactly about its intermediate axis (unstable: a "
-                      "uniform rotation that any round-off destroys)", racket, (0.0, 0.5, 0.0), ident, 100.0, 1001),
-        ReferenceCase("principal_axis_3", "the racket spun exactly about its axis of largest moment (stable)",
-                      racket, (0.0, 0.0, 0.5), ident, 100.0, 1001),
+        ReferenceCase(
+            "tennis_racket_circulating_1",
+            "flat racket spun near its intermediate axis; momentum circulates "
+            "about the axis of the smallest moment (L^2 < 2 E I2); 1 - k^2 = 1e-4",
+            racket,
+            (0.004, 0.4, 0.0),
+            ident,
+            200.0,
+            2001,
+            True,
+        ),
+        ReferenceCase(
+            "tennis_racket_circulating_3",
+            "the same racket on the other side of the separatrix: momentum "
+            "circulates about the axis of the largest moment (L^2 > 2 E I2); 1 - k^2 = 4e-4",
+            racket,
+            (0.0, 0.4, 0.004),
+            ident,
+            200.0,
+            2001,
+            True,
+        ),
+        ReferenceCase(
+            "tennis_racket_separatrix",
+            "the racket at 1 - k^2 = 1e-6 from the separatrix: flips every 82.94 s",
+            racket,
+            (0.0, 0.4, float(e)),
+            ident,
+            300.0,
+            3001,
+            True,
+        ),
+        ReferenceCase(
+            "full_tensor",
+            "a full non-diagonal inertia tensor, a tilted initial attitude",
+            ((2.0, 0.1, 0.0), (0.1, 1.5, -0.2), (0.0, -0.2, 1.2)),
+            (0.7, -1.1, 2.0),
+            q_tilt,
+            20.0,
+            2001,
+        ),
+        ReferenceCase(
+            "symmetric_top",
+            "a symmetric top (I1 = I2): a uniform precession",
+            (1.0, 1.0, 1.5),
+            (0.3, 0.2, 1.0),
+            q_tilt,
+            30.0,
+            3001,
+        ),
+        ReferenceCase(
+            "fast_spin",
+            "a fast spin, |Omega| = 100 rad/s, nearly about the axis of the largest moment",
+            (1.0, 2.0, 3.0),
+            (1.0, 0.5, 100.0),
+            ident,
+            10.0,
+            10001,
+        ),
+        ReferenceCase("long_run", "a long run to t = 1e4", (1.0, 2.0, 3.0), (1.0, 0.1, 0.5), ident, 1.0e4, 10001, True),
+        ReferenceCase(
+            "sphere",
+            "a spherical body: Omega constant, a uniform rotation",
+            (2.0, 2.0, 2.0),
+            (0.3, -0.4, 1.2),
+            q_tilt,
+            20.0,
+            2001,
+        ),
+        ReferenceCase(
+            "principal_axis_1",
+            "the racket spun exactly about its axis of smallest moment (stable)",
+            racket,
+            (0.5, 0.0, 0.0),
+            ident,
+            100.0,
+            1001,
+        ),
+        ReferenceCase(
+            "principal_axis_2",
+            "the racket spun exactly about its intermediate axis (unstable: a "
+            "uniform rotation that any round-off destroys)",
+            racket,
+            (0.0, 0.5, 0.0),
+            ident,
+            100.0,
+            1001,
+        ),
+        ReferenceCase(
+            "principal_axis_3",
+            "the racket spun exactly about its axis of largest moment (stable)",
+            racket,
+            (0.0, 0.0, 0.5),
+            ident,
+            100.0,
+            1001,
+        ),
     ]
 
 
@@ -225,7 +304,9 @@ def _readme(cases, netcdf: bool) -> str:
         "`wx, wy, wz` is the **body** angular velocity Omega (the space-frame rate is R Omega);",
         "E = Omega.I Omega / 2, m = R I Omega (constant).",
         "",
-        "Columns of every CSV: `" + ",".join(CSV_HEADER) + "` (17 significant digits)."
+        "Columns of every CSV: `"
+        + ",".join(CSV_HEADER)
+        + "` (17 significant digits)."
         + (" Each `.nc` file holds the same trajectory with its body (`eulerpoisson info NAME.nc`)." if netcdf else ""),
         "",
         "| case | inertia | Omega(0) | q(0) (w,x,y,z) | t | samples | |",
@@ -234,14 +315,21 @@ def _readme(cases, netcdf: bool) -> str:
     for c in cases:
         I = np.array(c.inertia, float)
         ishow = ", ".join(f"{x:g}" for x in I) if I.ndim == 1 else "; ".join(", ".join(f"{x:g}" for x in r) for r in I)
-        lines.append(f"| `{c.name}` | {ishow} | {', '.join(f'{x:.17g}' for x in c.omega0)} | "
-                     f"{', '.join(f'{x:.17g}' for x in c.quaternion0)} | 0 to {c.t_end:g} | {c.samples} | "
-                     f"{c.description} |")
+        lines.append(
+            f"| `{c.name}` | {ishow} | {', '.join(f'{x:.17g}' for x in c.omega0)} | "
+            f"{', '.join(f'{x:.17g}' for x in c.quaternion0)} | 0 to {c.t_end:g} | {c.samples} | "
+            f"{c.description} |"
+        )
     lines += ["", "Round trip (errors at round-off):", "", "```sh"]
     for c in cases[:2]:
         lines.append(f"eulerpoisson validate {c.name}.csv --inertia {c.inertia_flag()} --tolerance 1e-9")
-    lines += ["```", "", "The same cases in Python: `eulerpoisson.testing.reference_cases()`;"
-              " `eulerpoisson.testing.assert_free_motion(t, q, omega, inertia, atol=...)` checks a run in one line.", ""]
+    lines += [
+        "```",
+        "",
+        "The same cases in Python: `eulerpoisson.testing.reference_cases()`;"
+        " `eulerpoisson.testing.assert_free_motion(t, q, omega, inertia, atol=...)` checks a run in one line.",
+        "",
+    ]
     return "\n".join(lines)
 
 

@@ -141,6 +141,7 @@ class ValidationReport:
 
     def to_dict(self) -> dict:
         """The report as a JSON-able dict (no series)."""
+
         def fl(x):
             return None if x is None else [float(v) if np.isfinite(v) else None for v in x]
 
@@ -164,7 +165,9 @@ class ValidationReport:
             "verdict": self.verdict,
             "message": self.message,
             "convention_hint": self.convention_hint,
-            "suggested_conventions": None if self.suggested_conventions is None else self.suggested_conventions.to_dict(),
+            "suggested_conventions": None
+            if self.suggested_conventions is None
+            else self.suggested_conventions.to_dict(),
             "warnings": list(self.warnings),
         }
 
@@ -308,8 +311,14 @@ def _fitted_inertia(t, q, w):
     R = matrix_from_unit_quaternion(q[idx])
     x, y, z = W[:, 0], W[:, 1], W[:, 2]
     zero = np.zeros_like(x)
-    B = np.stack([np.stack([x, zero, zero, y, z, zero], -1), np.stack([zero, y, zero, x, zero, z], -1),
-                  np.stack([zero, zero, z, zero, x, y], -1)], axis=1)  # I W = B s, (N, 3, 6)
+    B = np.stack(
+        [
+            np.stack([x, zero, zero, y, z, zero], -1),
+            np.stack([zero, y, zero, x, zero, z], -1),
+            np.stack([zero, zero, z, zero, x, y], -1),
+        ],
+        axis=1,
+    )  # I W = B s, (N, 3, 6)
     Mspace = np.einsum("nij,njk->nik", R, B)  # m = R B s
     rows_m = (Mspace[1:] - Mspace[0]).reshape(-1, 6)
     Q = np.stack([x * x, y * y, z * z, 2 * x * y, 2 * x * z, 2 * y * z], -1)  # W.I W = Q s
@@ -346,10 +355,15 @@ def _inertia_warning(body, t, q, w) -> str | None:
     T = np.array([[s[0], s[3], s[4]], [s[3], s[1], s[5]], [s[4], s[5], s[2]]])
     if np.linalg.norm(T - body.inertia) <= 1e-3 * np.linalg.norm(body.inertia):
         return None
-    shown = np.round(np.diag(T), 4).tolist() if np.allclose(T, np.diag(np.diag(T)), atol=1e-6 * tr_given) \
+    shown = (
+        np.round(np.diag(T), 4).tolist()
+        if np.allclose(T, np.diag(np.diag(T)), atol=1e-6 * tr_given)
         else np.round(T, 4).tolist()
-    return (f"the run's energy and angular momentum are conserved as those of an inertia close to {shown} "
-            f"(scaled to the trace of the given one), not of the given inertia: check --inertia")
+    )
+    return (
+        f"the run's energy and angular momentum are conserved as those of an inertia close to {shown} "
+        f"(scaled to the trace of the given one), not of the given inertia: check --inertia"
+    )
 
 
 def _hint(stated: Conventions, best: Conventions, label_order: str) -> str:
@@ -390,8 +404,11 @@ def _detect(raw: RawRun, body, stated: Conventions, att: np.ndarray):
     so = stated.quaternion_order or raw.label_order
     best, best_err = None, float("inf")
     for conv in all_conventions(raw):
-        if (conv.quaternion_order, conv.omega_frame, conv.attitude_convention) == (so, stated.omega_frame,
-                                                                                  stated.attitude_convention):
+        if (conv.quaternion_order, conv.omega_frame, conv.attitude_convention) == (
+            so,
+            stated.omega_frame,
+            stated.attitude_convention,
+        ):
             continue
         try:
             tt, qq, ww = normalize_run(sub, conv)
@@ -405,8 +422,14 @@ def _detect(raw: RawRun, body, stated: Conventions, att: np.ndarray):
     return best
 
 
-def compare_run(raw: RawRun, inertia: ArrayLike | None = None, *, conventions: Conventions | None = None, tolerance: float | None = None,
-                detect: bool = True) -> ValidationReport:
+def compare_run(
+    raw: RawRun,
+    inertia: ArrayLike | None = None,
+    *,
+    conventions: Conventions | None = None,
+    tolerance: float | None = None,
+    detect: bool = True,
+) -> ValidationReport:
     """Validate a run against the exact free motion from its first sample.
 
     Parameters
@@ -449,13 +472,18 @@ def compare_run(raw: RawRun, inertia: ArrayLike | None = None, *, conventions: C
     if inertia is None:
         inertia = raw.inertia
     if inertia is None:
-        raise InvalidInputError(f"{raw.source}: give the inertia (--inertia I1,I2,I3 or nine numbers); the run does not state it")
+        raise InvalidInputError(
+            f"{raw.source}: give the inertia (--inertia I1,I2,I3 or nine numbers); the run does not state it"
+        )
     body = inertia if isinstance(inertia, RigidBody) else RigidBody(np.asarray(inertia, float))
     if body.batch_shape:
         raise InvalidInputError(f"one body, please: got a batch of shape {body.batch_shape}")
     if tolerance is not None:
-        if isinstance(tolerance, bool) or not isinstance(tolerance, (int, float, np.integer, np.floating)) or \
-                not (np.isfinite(tolerance) and tolerance > 0):
+        if (
+            isinstance(tolerance, bool)
+            or not isinstance(tolerance, (int, float, np.integer, np.floating))
+            or not (np.isfinite(tolerance) and tolerance > 0)
+        ):
             raise InvalidInputError(f"tolerance must be a positive number of radians, got {tolerance!r}")
         tolerance = float(tolerance)
     t, q, w = normalize_run(raw, conv)
@@ -482,8 +510,10 @@ def compare_run(raw: RawRun, inertia: ArrayLike | None = None, *, conventions: C
         exceeded = float(t[over[0]]) if over.size else None
         verdict = "fail" if (over.size or hint) else "pass"
         if over.size:
-            msg = (f"the attitude error first exceeds {tolerance:g} rad at t = {exceeded:.6g} (max {mx:.3g} rad at "
-                   f"t = {t[k]:.6g})")
+            msg = (
+                f"the attitude error first exceeds {tolerance:g} rad at t = {exceeded:.6g} (max {mx:.3g} rad at "
+                f"t = {t[k]:.6g})"
+            )
         else:
             msg = f"the attitude error stays within {tolerance:g} rad (max {mx:.3g} rad)"
             if hint:
@@ -491,21 +521,45 @@ def compare_run(raw: RawRun, inertia: ArrayLike | None = None, *, conventions: C
     elif mx <= ROUNDOFF and not hint:
         verdict, msg = "round-off", f"the run is the exact motion to round-off (max attitude error {mx:.3g} rad)"
     else:
-        verdict, msg = "differs", (f"the run differs from the exact motion by up to {mx:.3g} rad at t = {t[k]:.6g} "
-                                   f"(angular velocity: {float(np.max(om)):.3g} relative)")
+        verdict, msg = (
+            "differs",
+            (
+                f"the run differs from the exact motion by up to {mx:.3g} rad at t = {t[k]:.6g} "
+                f"(angular velocity: {float(np.max(om)):.3g} relative)"
+            ),
+        )
     if hint:
         msg += f"; {hint}"
     order = conv.quaternion_order or raw.label_order
     I = body.inertia
     inertia_out = np.diag(I).tolist() if np.all(I == np.diag(np.diag(I))) else I.tolist()
     return ValidationReport(
-        source=raw.source, samples=int(t.size), t_start=float(t[0]), t_end=float(t[-1]), inertia=inertia_out,
-        conventions=Conventions(order if order in QUATERNION_ORDERS else None, conv.omega_frame,
-                                conv.attitude_convention),
-        max_attitude_error=mx, max_attitude_error_time=float(t[k]), max_omega_error=float(np.max(om)),
-        energy_drift=float(np.max(de)), momentum_drift=float(np.max(dm)),
-        flip_times=flips[0], flip_times_run=flips[1], flip_time_errors=flips[2],
-        tolerance=tolerance, exceeded_at=exceeded, verdict=verdict, message=msg, convention_hint=hint,
-        suggested_conventions=best, warnings=tuple(warns),
-        t=t, attitude_error=att, omega_error=om, energy_error=de, momentum_error=dm,
+        source=raw.source,
+        samples=int(t.size),
+        t_start=float(t[0]),
+        t_end=float(t[-1]),
+        inertia=inertia_out,
+        conventions=Conventions(
+            order if order in QUATERNION_ORDERS else None, conv.omega_frame, conv.attitude_convention
+        ),
+        max_attitude_error=mx,
+        max_attitude_error_time=float(t[k]),
+        max_omega_error=float(np.max(om)),
+        energy_drift=float(np.max(de)),
+        momentum_drift=float(np.max(dm)),
+        flip_times=flips[0],
+        flip_times_run=flips[1],
+        flip_time_errors=flips[2],
+        tolerance=tolerance,
+        exceeded_at=exceeded,
+        verdict=verdict,
+        message=msg,
+        convention_hint=hint,
+        suggested_conventions=best,
+        warnings=tuple(warns),
+        t=t,
+        attitude_error=att,
+        omega_error=om,
+        energy_error=de,
+        momentum_error=dm,
     )

@@ -18,7 +18,12 @@ __all__ = ["plot_report"]
 FLOOR = 1e-17
 
 
-def plot_report(report: ValidationReport | list[tuple[str, ValidationReport]] | tuple[tuple[str, ValidationReport], ...], out: str | os.PathLike[str] | None = None, *, title: str | None = None) -> Figure:
+def plot_report(
+    report: ValidationReport | list[tuple[str, ValidationReport]] | tuple[tuple[str, ValidationReport], ...],
+    out: str | os.PathLike[str] | None = None,
+    *,
+    title: str | None = None,
+) -> Figure:
     """Draw a :class:`~eulerpoisson.oracle.ValidationReport`.
 
     Parameters
@@ -58,14 +63,18 @@ def plot_report(report: ValidationReport | list[tuple[str, ValidationReport]] | 
     from matplotlib import rcParams
     from matplotlib.figure import Figure  # no pyplot: no window, no global backend change
 
-    items: list[tuple[str, ValidationReport]] = [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
+    items: list[tuple[str, ValidationReport]] = (
+        [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
+    )
     fig = Figure(figsize=(8, 6.5), layout="constrained")
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     colors = rcParams["axes.prop_cycle"].by_key()["color"]
     for n, (label, r) in enumerate(items):
         c = colors[n % len(colors)]
         label = plain_text(label)
-        ax1.semilogy(r.t, np.maximum(r.attitude_error, FLOOR), color=c, label=f"{label} (max {r.max_attitude_error:.2g} rad)")
+        ax1.semilogy(
+            r.t, np.maximum(r.attitude_error, FLOOR), color=c, label=f"{label} (max {r.max_attitude_error:.2g} rad)"
+        )
         ax2.semilogy(r.t, np.maximum(r.energy_error, FLOOR), color=c, label=f"{label}: energy")
         ax2.semilogy(r.t, np.maximum(r.momentum_error, FLOOR), color=c, ls="--", label=f"{label}: |m - m0|/|m0|")
         if r.tolerance is not None and n == 0:

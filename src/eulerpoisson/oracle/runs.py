@@ -110,17 +110,22 @@ class Conventions:
     attitude_convention: str = "body-to-space"
 
     def __post_init__(self):
-        for name, value, allowed in (("quaternion_order", self.quaternion_order, QUATERNION_ORDERS + (None,)),
-                                     ("omega_frame", self.omega_frame, OMEGA_FRAMES),
-                                     ("attitude_convention", self.attitude_convention, ATTITUDE_CONVENTIONS)):
+        for name, value, allowed in (
+            ("quaternion_order", self.quaternion_order, QUATERNION_ORDERS + (None,)),
+            ("omega_frame", self.omega_frame, OMEGA_FRAMES),
+            ("attitude_convention", self.attitude_convention, ATTITUDE_CONVENTIONS),
+        ):
             if value not in allowed:
                 shown = ", ".join(repr(a) for a in allowed if a is not None)
                 raise InvalidInputError(f"{name} must be one of {shown}, got {value!r}")
 
     def to_dict(self) -> dict:
         """The three conventions as a JSON-able dict."""
-        return {"quaternion_order": self.quaternion_order, "omega_frame": self.omega_frame,
-                "attitude_convention": self.attitude_convention}
+        return {
+            "quaternion_order": self.quaternion_order,
+            "omega_frame": self.omega_frame,
+            "attitude_convention": self.attitude_convention,
+        }
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,8 +182,10 @@ def _check_arrays(t, q, w, source: str) -> tuple[np.ndarray, np.ndarray, np.ndar
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(f"{source}: the samples must be numbers ({exc})") from None
     if t.ndim != 1 or q.shape != t.shape + (4,) or w.shape != t.shape + (3,):
-        raise InvalidInputError(f"{source}: expected times (T,), quaternions (T, 4) and angular velocities (T, 3); "
-                                f"got shapes {t.shape}, {q.shape}, {w.shape}")
+        raise InvalidInputError(
+            f"{source}: expected times (T,), quaternions (T, 4) and angular velocities (T, 3); "
+            f"got shapes {t.shape}, {q.shape}, {w.shape}"
+        )
     if t.size < 2:
         raise InvalidInputError(f"{source}: a run needs at least 2 samples, got {t.size}")
     for name, a in (("t", t), ("quaternion", q), ("angular velocity", w)):
@@ -189,12 +196,16 @@ def _check_arrays(t, q, w, source: str) -> tuple[np.ndarray, np.ndarray, np.ndar
     dt = np.diff(t)
     if np.any(dt <= 0):
         i = int(np.argmax(dt <= 0)) + 1
-        raise InvalidInputError(f"{source}: times must increase strictly; sample {i} has t = {float(t[i])!r} after "
-                                f"t = {float(t[i - 1])!r} (sort the run, or drop repeated samples)")
+        raise InvalidInputError(
+            f"{source}: times must increase strictly; sample {i} has t = {float(t[i])!r} after "
+            f"t = {float(t[i - 1])!r} (sort the run, or drop repeated samples)"
+        )
     return t, q, w
 
 
-def run_from_arrays(t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, *, quaternion_order: str = "wxyz", source: str = "arrays") -> RawRun:
+def run_from_arrays(
+    t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, *, quaternion_order: str = "wxyz", source: str = "arrays"
+) -> RawRun:
     """A :class:`RawRun` from arrays.
 
     Parameters
@@ -232,10 +243,18 @@ def run_from_arrays(t: ArrayLike, quaternion: ArrayLike, omega: ArrayLike, *, qu
     arrays: times must increase strictly; sample 1 has t = 0.0 after t = 1.0 (sort the run, or drop repeated samples)
     """
     if quaternion_order not in QUATERNION_ORDERS:
-        raise InvalidInputError(f"quaternion_order must be one of {', '.join(QUATERNION_ORDERS)}, got {quaternion_order!r}")
+        raise InvalidInputError(
+            f"quaternion_order must be one of {', '.join(QUATERNION_ORDERS)}, got {quaternion_order!r}"
+        )
     t, q, w = _check_arrays(t, quaternion, omega, source)
-    return RawRun(t, q, w, label_order=quaternion_order, source=source,
-                  quaternion_columns=tuple(f"q{c}" for c in quaternion_order))
+    return RawRun(
+        t,
+        q,
+        w,
+        label_order=quaternion_order,
+        source=source,
+        quaternion_columns=tuple(f"q{c}" for c in quaternion_order),
+    )
 
 
 def _columns(names: list[str], source: str) -> tuple[int, list[int], str, list[int]]:
@@ -261,8 +280,10 @@ def _columns(names: list[str], source: str) -> tuple[int, list[int], str, list[i
             missing.append(f"w{c}")
         wi.append(j)
     if missing:
-        raise InvalidInputError(f"{source}: missing column(s) {', '.join(missing)} (expected a header like "
-                                f"{','.join(CSV_HEADER)}; got {','.join(names)})")
+        raise InvalidInputError(
+            f"{source}: missing column(s) {', '.join(missing)} (expected a header like "
+            f"{','.join(CSV_HEADER)}; got {','.join(names)})"
+        )
     return cast(int, it), qi, order, cast("list[int]", wi)  # none missing: all found
 
 
@@ -290,7 +311,9 @@ def _slow_table(path: str, header: list, data: list) -> np.ndarray:
             try:
                 vals[r, c] = float(text)
             except ValueError:
-                raise InvalidInputError(f"{path}: row {r + 2}, column {header[c].strip()}: {text!r} is not a number") from None
+                raise InvalidInputError(
+                    f"{path}: row {r + 2}, column {header[c].strip()}: {text!r} is not a number"
+                ) from None
     return vals
 
 
@@ -301,8 +324,10 @@ def _read_json(path: str) -> RawRun:
         except json.JSONDecodeError as exc:
             raise InvalidInputError(f"{path}: invalid JSON: {exc}") from None
     if not isinstance(recs, list) or not all(isinstance(r, dict) for r in recs) or not recs:
-        raise InvalidInputError(f"{path}: expected a JSON list of records like "
-                                '{"t": 0.0, "qw": 1.0, "qx": 0.0, "qy": 0.0, "qz": 0.0, "wx": 0.1, "wy": 0.2, "wz": 0.3}')
+        raise InvalidInputError(
+            f"{path}: expected a JSON list of records like "
+            '{"t": 0.0, "qw": 1.0, "qx": 0.0, "qy": 0.0, "qz": 0.0, "wx": 0.1, "wy": 0.2, "wz": 0.3}'
+        )
     keys = list(recs[0])
     if "quaternion" in keys and "omega" in keys and any(k in keys for k in _TIME_NAMES):
         tk = next(k for k in keys if k in _TIME_NAMES)
@@ -384,7 +409,9 @@ def read_run(path: str | os.PathLike[str]) -> RawRun:
         return _read_json(path)
     if ext in (".nc", ".nc4", ".netcdf"):
         return _read_netcdf(path)
-    raise InvalidInputError(f"{path}: unknown file type {ext or '(none)'!r}; a run is a .csv, .nc (NetCDF) or .json file")
+    raise InvalidInputError(
+        f"{path}: unknown file type {ext or '(none)'!r}; a run is a .csv, .nc (NetCDF) or .json file"
+    )
 
 
 def _permutation(order: str) -> list[int]:
@@ -392,7 +419,9 @@ def _permutation(order: str) -> list[int]:
     return [order.index(c) for c in "wxyz"]
 
 
-def normalize_run(raw: RawRun, conventions: Conventions | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+def normalize_run(
+    raw: RawRun, conventions: Conventions | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     r"""The run in eulerpoisson's conventions.
 
     Parameters
@@ -434,7 +463,8 @@ def normalize_run(raw: RawRun, conventions: Conventions | None = None) -> tuple[
         i = int(np.argmax(off > NORM_TOLERANCE))
         raise InvalidInputError(
             f"{raw.source}: the quaternion of sample {i} (t = {raw.t[i]:.6g}) has norm {nrm[i]:.9g}, far from 1 "
-            f"(tolerance {NORM_TOLERANCE:g}): not a rotation; are these columns a quaternion?")
+            f"(tolerance {NORM_TOLERANCE:g}): not a rotation; are these columns a quaternion?"
+        )
     q = q / nrm[:, None]
     if conv.attitude_convention == "space-to-body":
         q = q * np.array([1.0, -1.0, -1.0, -1.0])

@@ -289,7 +289,7 @@ class _Session:
             "Ginv": D.Ginv,
             "__builtins__": {"True": True, "False": False, "int": int, "abs": abs, "len": len},
         }
-        ns["at_origin"] = lambda e: (e.xreplace({x: 0 for x in n}) if hasattr(e, "xreplace") else e)
+        ns["at_origin"] = lambda e: e.xreplace({x: 0 for x in n}) if hasattr(e, "xreplace") else e
         self._claim_helpers(ns, D, frame)
         if frame == "plain":
             pass
@@ -298,9 +298,7 @@ class _Session:
             ns["y"] = lambda N: ys[int(N)]
             ns["lam"] = lambda A_, N: sp.Symbol(f"lambda_{int(A_)}{int(N)}", real=True)
             ns["a"] = lambda A_, N: sp.Symbol(f"a_{int(A_)}{int(N)}", real=True)
-            ns["total_force"] = lambda e: sp.Matrix(
-                [sum(sp.diff(e, ys[N][c]) for N in ys) for c in range(3)]
-            )
+            ns["total_force"] = lambda e: sp.Matrix([sum(sp.diff(e, ys[N][c]) for N in ys) for c in range(3)])
         elif frame == "rigid":
             ns["C0"] = sp.Matrix(sp.symbols("C0_1:4", real=True))
             ns["V0"] = sp.Matrix(sp.symbols("V0_1:4", real=True))
@@ -433,7 +431,12 @@ class _Session:
             X = _flatten(_resolve(X))
             bad = [s for x in X for s in D.inertia_symbols if not _sym.is_zero(sp.diff(x, s))]
             session.log.append(
-                (f"derivatives with respect to {', '.join(map(str, D.inertia_symbols))} vanish" if not bad else f"depends on {sorted(set(map(str, bad)))}", None)
+                (
+                    f"derivatives with respect to {', '.join(map(str, D.inertia_symbols))} vanish"
+                    if not bad
+                    else f"depends on {sorted(set(map(str, bad)))}",
+                    None,
+                )
             )
             return not bad
 
@@ -499,7 +502,9 @@ class _Session:
                 E[3 + j, i] = -E[i, 3 + j]
                 E[3 + i, 3 + j] = sum(
                     Sinv[i, a] * Sinv[j, b] * _sym.levi_civita(a, b, c) * J[c]
-                    for a in range(3) for b in range(3) for c in range(3)
+                    for a in range(3)
+                    for b in range(3)
+                    for c in range(3)
                 )
         E = E.applyfunc(_sym.rsimp)
         Dm = (L - E).applyfunc(_sym.rsimp)
@@ -967,8 +972,15 @@ def _run_check(session: _Session, entry: EntrySpec, spec: CheckSpec) -> CheckRes
         )
         inertia = spec.inertia if _derived_with_inertia(spec) else "none"
         return CheckResult(
-            label=spec.label, kind="claim", ok=ok, method="claim", inertia=inertia,
-            printed_latex=printed_latex, derived_latex=derived_latex, transcription=spec.printed, details=details,
+            label=spec.label,
+            kind="claim",
+            ok=ok,
+            method="claim",
+            inertia=inertia,
+            printed_latex=printed_latex,
+            derived_latex=derived_latex,
+            transcription=spec.printed,
+            details=details,
         )
 
     sides = _split_chain(spec.printed)
@@ -1031,10 +1043,21 @@ def _run_check(session: _Session, entry: EntrySpec, spec: CheckSpec) -> CheckRes
     derived_latex = _display(d_vals, spec.index, D)
     inertia = spec.inertia if (_derived_with_inertia(spec) or involved & set(D.inertia_symbols)) else "none"
     return CheckResult(
-        label=spec.label, kind="equal", ok=ok, method="+".join(sorted(methods)), inertia=inertia,
-        printed_latex=printed_latex, derived_latex=derived_latex, transcription=spec.printed,
-        corrected_ok=corrected_ok, corrected_latex=corrected_latex if not ok else None,
-        simpler_ok=simpler_ok, simpler_latex=simpler_latex, differs=differs, witness=witness, details=details,
+        label=spec.label,
+        kind="equal",
+        ok=ok,
+        method="+".join(sorted(methods)),
+        inertia=inertia,
+        printed_latex=printed_latex,
+        derived_latex=derived_latex,
+        transcription=spec.printed,
+        corrected_ok=corrected_ok,
+        corrected_latex=corrected_latex if not ok else None,
+        simpler_ok=simpler_ok,
+        simpler_latex=simpler_latex,
+        differs=differs,
+        witness=witness,
+        details=details,
         summary=summary,
     )
 
@@ -1091,12 +1114,48 @@ def _short_difference(dv, D) -> str:
 
 
 #: names whose canonical-frame values were derived through H (hence with the inertia tensor)
-_INERTIA_NAMES = {"I", "Iinv", "G", "Ginv", "H", "m", "Omega", "M", "omega", "ndot", "pidot", "Omegadot", "mdot",
-                  "Mdot", "L_of_pi", "ndot_of_pi", "EL", "Gamma2", "on_shell", "lie_symbolic_check",
-                  "lie_exact_check", "lie_numeric_check"}
-_INERTIA_DERIVED = {"H", "ndot_c", "pidot_c", "Omega_c", "m_c", "H_at_origin", "L", "G", "Ginv", "momenta",
-                    "hamilton_pi_residual", "hamilton_n_residual", "G_at_origin", "n2G_at_infinity",
-                    "G_at_infinity", "G_radial"}
+_INERTIA_NAMES = {
+    "I",
+    "Iinv",
+    "G",
+    "Ginv",
+    "H",
+    "m",
+    "Omega",
+    "M",
+    "omega",
+    "ndot",
+    "pidot",
+    "Omegadot",
+    "mdot",
+    "Mdot",
+    "L_of_pi",
+    "ndot_of_pi",
+    "EL",
+    "Gamma2",
+    "on_shell",
+    "lie_symbolic_check",
+    "lie_exact_check",
+    "lie_numeric_check",
+}
+_INERTIA_DERIVED = {
+    "H",
+    "ndot_c",
+    "pidot_c",
+    "Omega_c",
+    "m_c",
+    "H_at_origin",
+    "L",
+    "G",
+    "Ginv",
+    "momenta",
+    "hamilton_pi_residual",
+    "hamilton_n_residual",
+    "G_at_origin",
+    "n2G_at_infinity",
+    "G_at_infinity",
+    "G_radial",
+}
 
 
 def _code_names(src: str) -> set:
@@ -1133,7 +1192,9 @@ def _describe_difference(src, vals, ref, differing, index, side, nsides, D, ns) 
         parts.append(_component_label(comp, index) + "printed $-$ derived $= " + _short_difference(dv, D) + "$")
     more = len(differing) - 3
     where = f"member {side + 1} of {nsides}: " if nsides > 1 else ""
-    if "alpha" in ns and any(sp.sympify(vals[c]).has(ns["alpha"]) or sp.sympify(ref[c]).has(ns["alpha"]) for c in differing[:3]):
+    if "alpha" in ns and any(
+        sp.sympify(vals[c]).has(ns["alpha"]) or sp.sympify(ref[c]).has(ns["alpha"]) for c in differing[:3]
+    ):
         where += r"with $\tau=\tan(\alpha/2)$: "
     text = where + f"{len(differing)} of {len(vals)} components differ" + (": " if parts else "") + "; ".join(parts)
     if more > 0:
@@ -1153,7 +1214,9 @@ def _component_label(comp, index) -> str:
     return "component (" + ",".join(f"{n}={d}" for n, d in zip(index, digits)) + "): "
 
 
-def audit_entry(spec: EntrySpec, *, session: _Session | None = None, seed: int = 20240607, points: int = N_POINTS) -> EntryResult:
+def audit_entry(
+    spec: EntrySpec, *, session: _Session | None = None, seed: int = 20240607, points: int = N_POINTS
+) -> EntryResult:
     """Audit one entry: evaluate its checks and compute its status.
 
     Parameters
@@ -1210,8 +1273,17 @@ def audit_entry(spec: EntrySpec, *, session: _Session | None = None, seed: int =
     if spec.definition:
         note = f"Not checkable as such: {spec.definition}. " + note
     return EntryResult(
-        spec=spec, status=status, checks=checks, inertia=inertia, method="+".join(methods) or "none",
-        printed=spec.latex, derived=derived, corrected=corrected, simpler=simpler, differs=differs, note=note,
+        spec=spec,
+        status=status,
+        checks=checks,
+        inertia=inertia,
+        method="+".join(methods) or "none",
+        printed=spec.latex,
+        derived=derived,
+        corrected=corrected,
+        simpler=simpler,
+        differs=differs,
+        note=note,
         differs_summary=summary,
     )
 
@@ -1294,7 +1366,14 @@ def _transfer(rat, src, dst, values):
         if s in dst.index:
             pos.append(("g", dst.index[s]))
         elif s in values:
-            pos.append(("v", sp.QQ.convert(values[s]) if not isinstance(values[s], sp.Rational) else sp.QQ(int(values[s].p), int(values[s].q))))
+            pos.append(
+                (
+                    "v",
+                    sp.QQ.convert(values[s])
+                    if not isinstance(values[s], sp.Rational)
+                    else sp.QQ(int(values[s].p), int(values[s].q)),
+                )
+            )
         else:
             pos.append(("x", s))
     ng = len(dst.symbols)
@@ -1360,13 +1439,22 @@ def _lie_exact_check(D, order, npoints, seed):
         rep = {}
         if D.inertia == "general":
             syms = D.inertia_symbols
-            rep = {syms[0]: I[0, 0], syms[1]: I[0, 1], syms[2]: I[0, 2], syms[3]: I[1, 1], syms[4]: I[1, 2], syms[5]: I[2, 2]}
+            rep = {
+                syms[0]: I[0, 0],
+                syms[1]: I[0, 1],
+                syms[2]: I[0, 2],
+                syms[3]: I[1, 1],
+                syms[4]: I[1, 2],
+                syms[5]: I[2, 2],
+            }
         else:  # pragma: no cover - the audit uses the general derivation
             rep = {s: I[i, i] for i, s in enumerate(D.inertia_symbols)}
         ok, deg = _series_residual_zero(D, C, rep, order)
         all_ok = all_ok and ok
         texts.append(f"I={I.tolist()}, pi0={[str(x) for x in pi0]}: " + ("ok" if ok else f"fails at t^{deg}"))
-    return all_ok, f"order {order}, exact rational general inertia and pi0 at {npoints} random points: " + "; ".join(texts)
+    return all_ok, f"order {order}, exact rational general inertia and pi0 at {npoints} random points: " + "; ".join(
+        texts
+    )
 
 
 #: Inertia and initial momenta of the numeric Lie-series check (a general, non-diagonal body).
@@ -1381,8 +1469,12 @@ def _lie_numeric_check(orders):
         chk = _sym.check_lie_series(int(order), LIE_NUMERIC_INERTIA, LIE_NUMERIC_PI0)
         good = abs(chk.slope - (order + 1)) < 0.5
         ok = ok and good
-        texts.append(f"order {order}: slope {chk.slope:.2f} (expected {order + 1}), errors {', '.join(f'{e:.1e}' for e in chk.errors)}")
-    return ok, "vs solve_ivp (DOP853, rtol 1e-13) of (1.16) with I = " + str([list(r) for r in LIE_NUMERIC_INERTIA]) + ", pi0 = " + str(list(LIE_NUMERIC_PI0)) + ": " + "; ".join(texts)
+        texts.append(
+            f"order {order}: slope {chk.slope:.2f} (expected {order + 1}), errors {', '.join(f'{e:.1e}' for e in chk.errors)}"
+        )
+    return ok, "vs solve_ivp (DOP853, rtol 1e-13) of (1.16) with I = " + str(
+        [list(r) for r in LIE_NUMERIC_INERTIA]
+    ) + ", pi0 = " + str(list(LIE_NUMERIC_PI0)) + ": " + "; ".join(texts)
 
 
 # ---------------------------------------------------------------------------
@@ -1475,8 +1567,13 @@ class AuditReport:
             "counts": counts,
             "total": len(self.entries),
             "misprints": [
-                {"equation": e.equation, "title": e.spec.title, "summary": e.differs_summary, "differs": e.differs,
-                 "corrected": e.corrected}
+                {
+                    "equation": e.equation,
+                    "title": e.spec.title,
+                    "summary": e.differs_summary,
+                    "differs": e.differs,
+                    "corrected": e.corrected,
+                }
                 for e in self.entries
                 if e.status == "misprint"
             ],
@@ -1539,8 +1636,13 @@ def _jsonable(x):
     return str(x)
 
 
-def run_audit(*, entries: Sequence[EntrySpec] | None = None, seed: int = 20240607, points: int = N_POINTS,
-              integrability: bool = True) -> AuditReport:
+def run_audit(
+    *,
+    entries: Sequence[EntrySpec] | None = None,
+    seed: int = 20240607,
+    points: int = N_POINTS,
+    integrability: bool = True,
+) -> AuditReport:
     """Run the audit of the paper.
 
     Parameters
@@ -1652,7 +1754,9 @@ def _to_markdown(rep: AuditReport) -> str:
         out.append("")
         out.append(f"### {e.equation} — {_md_text(e.spec.title)}")
         out.append("")
-        out.append(f"*Status:* **{e.status}** · *method:* {e.method} · *inertia:* {e.inertia} · *section:* {_md_text(e.spec.section)}")
+        out.append(
+            f"*Status:* **{e.status}** · *method:* {e.method} · *inertia:* {e.inertia} · *section:* {_md_text(e.spec.section)}"
+        )
         out.append("")
         out.append(f"*Context:* {_md_text(e.spec.context)}")
         out.append("")
@@ -1684,7 +1788,9 @@ def _to_markdown(rep: AuditReport) -> str:
         for c in e.checks:
             res = "ok" if c.ok else "FAILS"
             extra = ("; " + "; ".join(c.details)) if c.details else ""
-            out.append(f"| {_md_text(c.label)} | {res}{_md_text(extra)} | {c.method} | `{c.transcription.replace('|', '/')}` |")
+            out.append(
+                f"| {_md_text(c.label)} | {res}{_md_text(extra)} | {c.method} | `{c.transcription.replace('|', '/')}` |"
+            )
     out.append("")
     out.append("## Integrability (computed)")
     out.append("")
@@ -1693,11 +1799,17 @@ def _to_markdown(rep: AuditReport) -> str:
         for k, v in integ["involution"].items():
             kk = k.replace("{", r"\{").replace("}", r"\}").replace("m^2", r"\mathbf m^2")
             out.append(f"- ${kk}$ = {v}")
-        out.append(f"- rank of the Jacobian of $(H, \\mathbf m^2, m_3)$ w.r.t. $(\\mathbf n, \\boldsymbol\\pi)$: {integ['jacobian_rank']} (random rational points: {integ['jacobian_ranks_at_random_points']})")
+        out.append(
+            f"- rank of the Jacobian of $(H, \\mathbf m^2, m_3)$ w.r.t. $(\\mathbf n, \\boldsymbol\\pi)$: {integ['jacobian_rank']} (random rational points: {integ['jacobian_ranks_at_random_points']})"
+        )
         for chart, name in (("nm", "(n, m)"), ("nOmega", "(n, Omega)"), ("nM", "(n, M)")):
-            out.append(f"- Poisson tensor in {name}: Pfaffian ${integ['pfaffian_' + chart + '_latex']}$, determinant ${integ['det_' + chart + '_latex']}$")
+            out.append(
+                f"- Poisson tensor in {name}: Pfaffian ${integ['pfaffian_' + chart + '_latex']}$, determinant ${integ['det_' + chart + '_latex']}$"
+            )
             e3 = integ[f"e3_{chart}"]
-            out.append(f"  - linearised at 0 vs $e(3)$ ({e3['identification']}); difference: $${e3['difference_latex']}$$")
+            out.append(
+                f"  - linearised at 0 vs $e(3)$ ({e3['identification']}); difference: $${e3['difference_latex']}$$"
+            )
     out.append("")
     return "\n".join(out)
 
@@ -1707,8 +1819,18 @@ def _tex_escape(s: str) -> str:
     if len(parts) > 1:
         return r"$\rightarrow$".join(_tex_escape(p) for p in parts)
     rep = {
-        "\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "#": r"\#", "_": r"\_", "{": r"\{", "}": r"\}",
-        "~": r"\textasciitilde{}", "^": r"\textasciicircum{}", "$": r"\$", "<": r"\textless{}", ">": r"\textgreater{}",
+        "\\": r"\textbackslash{}",
+        "&": r"\&",
+        "%": r"\%",
+        "#": r"\#",
+        "_": r"\_",
+        "{": r"\{",
+        "}": r"\}",
+        "~": r"\textasciitilde{}",
+        "^": r"\textasciicircum{}",
+        "$": r"\$",
+        "<": r"\textless{}",
+        ">": r"\textgreater{}",
         "|": r"\textbar{}",
     }
     out = "".join(rep.get(c, c) for c in s)
@@ -1763,7 +1885,9 @@ def _to_latex(rep: AuditReport) -> str:
     L.append(r"\setlength{\textheight}{24cm}\setlength{\topmargin}{-1.5cm}")
     L.append(r"\allowdisplaybreaks")
     L.append(r"\sloppy")
-    L.append(r"\title{Machine-checked audit of: Geodesic motion on the symplectic leaf of $SO(3)$ with distorted $e(3)$ algebra and Liouville integrability of a free rigid body}")
+    L.append(
+        r"\title{Machine-checked audit of: Geodesic motion on the symplectic leaf of $SO(3)$ with distorted $e(3)$ algebra and Liouville integrability of a free rigid body}"
+    )
     L.append(r"\author{eulerpoisson " + _tex_escape(str(rep.meta.get("eulerpoisson", ""))) + r"}")
     L.append(r"\date{}")
     L.append(r"\begin{document}")
@@ -1779,7 +1903,9 @@ def _to_latex(rep: AuditReport) -> str:
     )
     L.append(r"\section*{Summary}")
     L.append(r"\begin{longtable}{p{3.2cm}p{2.0cm}p{3.2cm}p{1.5cm}p{5.4cm}}")
-    L.append(r"\textbf{Equation} & \textbf{Status} & \textbf{Method} & \textbf{Inertia} & \textbf{Title}\\ \hline \endhead")
+    L.append(
+        r"\textbf{Equation} & \textbf{Status} & \textbf{Method} & \textbf{Inertia} & \textbf{Title}\\ \hline \endhead"
+    )
     for e in rep.entries:
         L.append(
             f"{_tex_escape(e.equation)} & {_tex_escape(e.status)} & {_tex_escape(e.method)} & {_tex_escape(e.inertia)} & {_tex_escape(e.spec.title)} \\\\"
@@ -1789,7 +1915,14 @@ def _to_latex(rep: AuditReport) -> str:
         L.append(r"\section*{Misprints}")
         L.append(r"\begin{itemize}")
         for m in summ["misprints"]:
-            L.append(r"\item \textbf{" + _tex_escape(m["equation"]) + "} (" + _tex_escape(m["title"]) + "): " + _tex_text(m["summary"]))
+            L.append(
+                r"\item \textbf{"
+                + _tex_escape(m["equation"])
+                + "} ("
+                + _tex_escape(m["title"])
+                + "): "
+                + _tex_text(m["summary"])
+            )
             if m["corrected"]:
                 L.append(r"\par\noindent Corrected: " + _tex_math_block(m["corrected"]))
         L.append(r"\end{itemize}")
@@ -1797,8 +1930,13 @@ def _to_latex(rep: AuditReport) -> str:
     for e in rep.entries:
         L.append(r"\subsection*{" + _tex_escape(f"{e.equation}: {e.spec.title}") + "}")
         L.append(
-            r"\textbf{Status:} " + _tex_escape(e.status) + r"\quad \textbf{Method:} " + _tex_escape(e.method)
-            + r"\quad \textbf{Inertia:} " + _tex_escape(e.inertia) + r"\par"
+            r"\textbf{Status:} "
+            + _tex_escape(e.status)
+            + r"\quad \textbf{Method:} "
+            + _tex_escape(e.method)
+            + r"\quad \textbf{Inertia:} "
+            + _tex_escape(e.inertia)
+            + r"\par"
         )
         L.append(r"\noindent\textbf{Context:} " + _tex_context(e.spec.context) + r"\par")
         L.append(r"\noindent\textbf{Printed:}")
@@ -1827,20 +1965,38 @@ def _to_latex(rep: AuditReport) -> str:
         L.append(r"\section*{Integrability (computed)}")
         L.append(r"\begin{itemize}")
         for k, v in integ["involution"].items():
-            L.append(r"\item $" + k.replace("{", r"\{").replace("}", r"\}").replace("m^2", r"\mathbf m^2") + "$ = " + _tex_escape(v))
+            L.append(
+                r"\item $"
+                + k.replace("{", r"\{").replace("}", r"\}").replace("m^2", r"\mathbf m^2")
+                + "$ = "
+                + _tex_escape(v)
+            )
         L.append(
             r"\item Rank of the Jacobian of $(H,\mathbf m^2,m_3)$ with respect to $(\mathbf n,\boldsymbol\pi)$: "
             + _tex_escape(str(integ["jacobian_rank"]))
         )
-        for chart, name in (("nm", r"(\mathbf n,\mathbf m)"), ("nOmega", r"(\mathbf n,\boldsymbol\Omega)"), ("nM", r"(\mathbf n,\mathbf M)")):
+        for chart, name in (
+            ("nm", r"(\mathbf n,\mathbf m)"),
+            ("nOmega", r"(\mathbf n,\boldsymbol\Omega)"),
+            ("nM", r"(\mathbf n,\mathbf M)"),
+        ):
             L.append(
-                r"\item Poisson tensor in $" + name + r"$: Pfaffian $" + integ[f"pfaffian_{chart}_latex"] + r"$, determinant $"
-                + integ[f"det_{chart}_latex"] + "$."
+                r"\item Poisson tensor in $"
+                + name
+                + r"$: Pfaffian $"
+                + integ[f"pfaffian_{chart}_latex"]
+                + r"$, determinant $"
+                + integ[f"det_{chart}_latex"]
+                + "$."
             )
             e3 = integ[f"e3_{chart}"]
             L.append(
-                r" Linearised at the origin minus $e(3)$ (" + _tex_escape(e3["identification"]) + r"):"
-                + r"\begin{gather*}" + e3["difference_latex"] + r"\end{gather*}"
+                r" Linearised at the origin minus $e(3)$ ("
+                + _tex_escape(e3["identification"])
+                + r"):"
+                + r"\begin{gather*}"
+                + e3["difference_latex"]
+                + r"\end{gather*}"
             )
         L.append(r"\end{itemize}")
     L.append(r"\end{document}")

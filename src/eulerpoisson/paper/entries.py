@@ -443,10 +443,18 @@ ENTRIES: tuple[EntrySpec, ...] = (
         title="Conversion matrix A and its inverse",
         section=S1,
         context=r"where the conversion matrix is",
-        latex=r"A_{ij}=\frac{1}{1+{\bf n}^2}\left[\delta_{ij}-\epsilon_{ijk}n_k\right], \quad \mbox{then} \quad A^{-1}_{ij}\equiv\tilde A_{ij}=\delta_{ij}+n_j n_j" + "\n" + r"+\epsilon_{ijk}n_k.",
+        latex=r"A_{ij}=\frac{1}{1+{\bf n}^2}\left[\delta_{ij}-\epsilon_{ijk}n_k\right], \quad \mbox{then} \quad A^{-1}_{ij}\equiv\tilde A_{ij}=\delta_{ij}+n_j n_j"
+        + "\n"
+        + r"+\epsilon_{ijk}n_k.",
         note="Derived $A = \\frac12(\\partial\\boldsymbol\\Omega/\\partial\\dot{\\mathbf n})^T$ and $\\tilde A = A^{-1}$ (exact inverse). The printed $n_j n_j$ is transcribed literally as $n_j^2$ ($j$ is a free index).",
         checks=(
-            CheckSpec(label="A", index="ij", printed=_A12, derived="A", latex=r"A_{ij}=\frac{1}{1+{\bf n}^2}\left[\delta_{ij}-\epsilon_{ijk}n_k\right]"),
+            CheckSpec(
+                label="A",
+                index="ij",
+                printed=_A12,
+                derived="A",
+                latex=r"A_{ij}=\frac{1}{1+{\bf n}^2}\left[\delta_{ij}-\epsilon_{ijk}n_k\right]",
+            ),
             CheckSpec(
                 label="A^{-1}",
                 index="ij",
@@ -473,7 +481,9 @@ ENTRIES: tuple[EntrySpec, ...] = (
         title="Lagrangian in unconstrained variables; the metric G",
         section=S1,
         context=r"Using these expressions in (1.10), we get the Lagrangian in terms of unconstrained variables [...] with the metric $G_{ij}({\bf n})=4(AIA^T)_{ij}$.",
-        latex=r"L=2 I_{ij}(A^T\dot{\bf n})_i(A^T\dot{\bf n})_j=\frac12G_{ij}({\bf n})\dot n_i\dot n_j=\frac{2}{(1+{\bf n}^2)^2}I_{ij} \left[\dot{\bf n}-[{\bf n}, \dot{\bf n}]\right]_i" + "\n" + r"\left[\dot{\bf n}-[{\bf n}, \dot{\bf n}]\right]_j.",
+        latex=r"L=2 I_{ij}(A^T\dot{\bf n})_i(A^T\dot{\bf n})_j=\frac12G_{ij}({\bf n})\dot n_i\dot n_j=\frac{2}{(1+{\bf n}^2)^2}I_{ij} \left[\dot{\bf n}-[{\bf n}, \dot{\bf n}]\right]_i"
+        + "\n"
+        + r"\left[\dot{\bf n}-[{\bf n}, \dot{\bf n}]\right]_j.",
         note="Derived $L = \\frac12 I_{ij}\\Omega_i\\Omega_j$ with $\\boldsymbol\\Omega(\\mathbf n,\\dot{\\mathbf n})$ from $R(\\mathbf n)$, and $G_{ij} = \\partial^2 L/\\partial\\dot n_i\\partial\\dot n_j$; general symmetric $I$. In the middle member $G$ is the printed $4AIA^T$.",
         checks=(
             CheckSpec(
@@ -534,7 +544,9 @@ ENTRIES: tuple[EntrySpec, ...] = (
                 corrected_latex=r"{\bf n}^2 G_{ij}\rightarrow 4(\hat e I\hat e^T)_{ij},\quad \hat e_{ij}=\epsilon_{ijk}e_k,\ {\bf e}={\bf n}/|{\bf n}|",
                 differs="$G$ does fall off like $1/\\mathbf n^2$ in the directions transverse to $\\mathbf n$, but the coefficient is the degenerate tensor $4\\hat eI\\hat e^T$, not $\\delta$; the radial component falls off like $1/\\mathbf n^4$",
             ),
-            CheckSpec(label="G vanishes at infinity", frame="asymptotic", index="ij", printed="0", derived="G_at_infinity"),
+            CheckSpec(
+                label="G vanishes at infinity", frame="asymptotic", index="ij", printed="0", derived="G_at_infinity"
+            ),
             CheckSpec(
                 label="supplementary (not printed): radial component",
                 frame="asymptotic",
@@ -661,7 +673,9 @@ ENTRIES: tuple[EntrySpec, ...] = (
         title="Hamilton's equations",
         section=S2,
         context=r"The Hamiltonian equations of motion can be then obtained according the standard rule: $\dot n_i=\{ n_i, H\}$, $\dot\pi_i=\{\pi_i, H\}$, and read as follows:",
-        latex=r"\dot n_i=\frac14(\tilde A^T I^{-1}\tilde A{\boldsymbol\pi})_i, \qquad" + "\n" + r"\dot\pi_i=-\frac14[\delta_{ij}({\bf n}, {\boldsymbol\pi})+\pi_in_j+\epsilon_{ijk}n_k](I^{-1}\tilde A{\boldsymbol\pi})_j.",
+        latex=r"\dot n_i=\frac14(\tilde A^T I^{-1}\tilde A{\boldsymbol\pi})_i, \qquad"
+        + "\n"
+        + r"\dot\pi_i=-\frac14[\delta_{ij}({\bf n}, {\boldsymbol\pi})+\pi_in_j+\epsilon_{ijk}n_k](I^{-1}\tilde A{\boldsymbol\pi})_j.",
         note="$\\{n_i, H\\}$ and $\\{\\pi_i, H\\}$ from the derived $H$, general symmetric $I$.",
         checks=(
             CheckSpec(
@@ -810,7 +824,11 @@ ENTRIES: tuple[EntrySpec, ...] = (
         title="Poisson brackets of (n, m)",
         section=S2,
         context=r"Poisson structure of the theory in these variables is [...] where $\hat n_{ij}\equiv \epsilon_{ijp}n_p$ is the antisymmetric matrix equivalent to the vector $n_p$.",
-        latex=r"\{n_i, n_j\}=0, \qquad   \{n_i, m_j\}=\frac12 \tilde A_{ij}=\frac12 [\epsilon_{ijk}n_k+\delta_{ij}+n_i n_j], \cr" + "\n" + r"\{m_i, m_j\}=\frac{1}{1+{\bf n}^2}[\epsilon_{ijk}m_k+" + "\n" + r"(\hat n_{ij}n_k+cycle\,(ijk) )m_k], \quad",
+        latex=r"\{n_i, n_j\}=0, \qquad   \{n_i, m_j\}=\frac12 \tilde A_{ij}=\frac12 [\epsilon_{ijk}n_k+\delta_{ij}+n_i n_j], \cr"
+        + "\n"
+        + r"\{m_i, m_j\}=\frac{1}{1+{\bf n}^2}[\epsilon_{ijk}m_k+"
+        + "\n"
+        + r"(\hat n_{ij}n_k+cycle\,(ijk) )m_k], \quad",
         note="Brackets computed with the canonical bracket and rewritten with $\\boldsymbol\\pi = 2A^T\\mathbf m$. 'cycle (ijk)' is read as the sum over cyclic permutations, $\\hat n_{ij}n_k+\\hat n_{jk}n_i+\\hat n_{ki}n_j$. Since this sum equals $\\mathbf n^2\\epsilon_{ijk}$, the bracket collapses to the $so(3)$ bracket.",
         checks=(
             CheckSpec(label="{n_i, n_j}", frame="nm", index="ij", printed="0", derived="PBnn"),
@@ -839,7 +857,14 @@ ENTRIES: tuple[EntrySpec, ...] = (
         context=r"Even in the linear approximation, this algebra is different from the isometry algebra $e(3)$ of ${\mathbb R}^3$.",
         latex=r"Even in the linear approximation, this algebra is different from the isometry algebra $e(3)$ of ${\mathbb R}^3$.",
         note="Linearised at $(\\mathbf n,\\mathbf m)=0$ and compared with $e(3)$, $\\{J_i,J_j\\}=\\epsilon_{ijk}J_k$, $\\{J_i,P_j\\}=\\epsilon_{ijk}P_k$, $\\{P_i,P_j\\}=0$, with $\\mathbf J=\\mathbf m$, $\\mathbf P = c\\,\\mathbf n$ (any $c\\neq0$): $\\{m_i,m_j\\}$ agrees, but $\\{n_i, m_j\\}$ has the constant term $\\frac12\\delta_{ij}$ (which makes the structure symplectic) and the coefficient $\\frac12$ instead of $1$ in front of $\\epsilon_{ijk}n_k$. The difference is shown in the integrability section.",
-        checks=(CheckSpec(label="linearised (n,m) minus e(3)", frame="nm", kind="claim", printed="nonzero_matrix(e3_difference('nm'))"),),
+        checks=(
+            CheckSpec(
+                label="linearised (n,m) minus e(3)",
+                frame="nm",
+                kind="claim",
+                printed="nonzero_matrix(e3_difference('nm'))",
+            ),
+        ),
     ),
     EntrySpec(
         equation="after 1.21 (nondegenerate)",
@@ -848,9 +873,7 @@ ENTRIES: tuple[EntrySpec, ...] = (
         context=r"We also emphasise that the Poisson tensor determined by (1.21) is just the canonical Poisson tensor (1.18) written in a noncanonical coordinates of the phase space. This implies, in particular, that the Poisson structure (1.21) is nondegenerate and hence does not admite the Casimir functions.",
         latex=r"the Poisson structure (\ref{u1.21}) is nondegenerate",
         note="Pfaffian of the $6\\times6$ Poisson tensor of $(\\mathbf n,\\mathbf m)$ computed symbolically: $\\mathrm{Pf} = -(1+\\mathbf n^2)^2/8$, $\\det = (1+\\mathbf n^2)^4/64$. Editorial: the sentence refers to 'the canonical Poisson tensor (1.18)'; the canonical brackets are eq. (1.15.1) (eq. (1.18) is the bracket of $\\tilde A^T\\pi$ with $\\tilde A\\pi$).",
-        checks=(
-            CheckSpec(label="Pfaffian", frame="nm", kind="claim", printed="nonzero(pfaffian(P))"),
-        ),
+        checks=(CheckSpec(label="Pfaffian", frame="nm", kind="claim", printed="nonzero(pfaffian(P))"),),
     ),
     EntrySpec(
         equation="after 1.21 (no Casimir)",
@@ -903,7 +926,9 @@ ENTRIES: tuple[EntrySpec, ...] = (
         context=r"Using this identity and Eq. (1.21) we conclude, that the phase-space function ${\bf m}^2$ has vanishing brackets with $m_i$",
         latex=r"\{m_i, {\bf m}^2\}=0.",
         note="Canonical bracket of $\\mathbf m(\\mathbf n,\\boldsymbol\\pi)$.",
-        checks=(CheckSpec(label="{m_i, m^2}", frame="canonical", index="i", printed="PB(m[i], dot(m,m))", derived="zero"),),
+        checks=(
+            CheckSpec(label="{m_i, m^2}", frame="canonical", index="i", printed="PB(m[i], dot(m,m))", derived="zero"),
+        ),
     ),
     EntrySpec(
         equation="after 1.23 (involution)",
@@ -932,10 +957,31 @@ ENTRIES: tuple[EntrySpec, ...] = (
         latex=r"z^a(t, z^b_0)=e^{t\{z^c_0, ~H(n_{0 i}, \pi_{0 j})\}\frac{\partial}{\partial z^c_0}}z^a_0, \qquad \mbox{where} \quad   z^a=( n_i, \pi_j).",
         note="Truncated Lie series $\\sum_k t^k L_H^k z/k!$ at $\\mathbf n_0 = 0$ (symbolic.lie_series): (i) its Taylor coefficients satisfy Hamilton's equations of the derived $H$ exactly up to the truncation order, for symbolic $\\boldsymbol\\pi_0$ and a symbolic general $I$ (order 3) and for two random rational general $I$, $\\boldsymbol\\pi_0$ (order 6); (ii) against solve_ivp of (1.16) the truncation error scales like $t^{\\mathrm{order}+1}$ (orders 2-6); (iii) $\\boldsymbol\\Omega(0)=\\frac12I^{-1}\\boldsymbol\\pi_0$ is invertible, so the three constants $\\pi_{0i}$ reach every initial angular velocity (general solution).",
         checks=(
-            CheckSpec(label="series solves Hamilton's equations (symbolic)", frame="canonical", kind="claim", printed="lie_symbolic_check(3)", inertia="general"),
-            CheckSpec(label="series solves Hamilton's equations (exact, random)", frame="canonical", kind="claim", printed="lie_exact_check(6, 2)"),
-            CheckSpec(label="truncation error ~ t^(order+1)", frame="canonical", kind="claim", printed="lie_numeric_check((2, 3, 4, 5, 6))"),
-            CheckSpec(label="pi_0 parametrises all initial Omega", frame="canonical", kind="claim", printed="nonzero(det(jac(at_origin(Omega), pi)))"),
+            CheckSpec(
+                label="series solves Hamilton's equations (symbolic)",
+                frame="canonical",
+                kind="claim",
+                printed="lie_symbolic_check(3)",
+                inertia="general",
+            ),
+            CheckSpec(
+                label="series solves Hamilton's equations (exact, random)",
+                frame="canonical",
+                kind="claim",
+                printed="lie_exact_check(6, 2)",
+            ),
+            CheckSpec(
+                label="truncation error ~ t^(order+1)",
+                frame="canonical",
+                kind="claim",
+                printed="lie_numeric_check((2, 3, 4, 5, 6))",
+            ),
+            CheckSpec(
+                label="pi_0 parametrises all initial Omega",
+                frame="canonical",
+                kind="claim",
+                printed="nonzero(det(jac(at_origin(Omega), pi)))",
+            ),
         ),
     ),
     EntrySpec(
@@ -992,7 +1038,9 @@ ENTRIES: tuple[EntrySpec, ...] = (
         latex=r"{\boldsymbol\Omega}=\frac12 I^{-1}\tilde A{\boldsymbol\pi}, \qquad {\boldsymbol\pi}=2AI{\boldsymbol\Omega}.",
         note="General symmetric $I$.",
         checks=(
-            CheckSpec(label="Omega(n, pi)", frame="canonical", index="i", printed="1/2*(Iinv*At*pi)[i]", derived="Omega_c"),
+            CheckSpec(
+                label="Omega(n, pi)", frame="canonical", index="i", printed="1/2*(Iinv*At*pi)[i]", derived="Omega_c"
+            ),
             CheckSpec(label="pi(n, Omega)", frame="nOmega", index="i", printed="2*(A*I*Omega)[i]", derived="pi"),
         ),
     ),
@@ -1003,14 +1051,23 @@ ENTRIES: tuple[EntrySpec, ...] = (
         context=r"Using this in Eq. (1.15) we get the Hamiltonian",
         latex=r"H=\frac12 I_{ij}\Omega_i\Omega_j,",
         note="General symmetric $I$.",
-        checks=(CheckSpec(label="H(n, Omega)", frame="nOmega", printed="1/2*sum(I[i,j]*Omega[i]*Omega[j] for i in R3 for j in R3)", derived="H"),),
+        checks=(
+            CheckSpec(
+                label="H(n, Omega)",
+                frame="nOmega",
+                printed="1/2*sum(I[i,j]*Omega[i]*Omega[j] for i in R3 for j in R3)",
+                derived="H",
+            ),
+        ),
     ),
     EntrySpec(
         equation="1.28",
         title="Poisson brackets of (n, Omega)",
         section=S3,
         context=r"while the canonical Poisson brackets (1.15.1) imply",
-        latex=r"\{n_i, n_j\}=0, \qquad \{n_i, \Omega_j\}=\frac12(\tilde A^TI^{-1})_{ij}=\frac12[-\epsilon_{ikp}n_p+\delta_{ik}+n_i n_k]I^{-1}_{kj},  \quad ~ \cr" + "\n" + r"\{\Omega_i, \Omega_j\}=\frac{-1}{1+{\bf n}^2}(I^{-1})_{ia}(I^{-1})_{jb}\left[\epsilon_{abc}(I\Omega)_c+(\hat n_{ab}n_c+cycle \, (abc)\,)(I\Omega)_c\right].",
+        latex=r"\{n_i, n_j\}=0, \qquad \{n_i, \Omega_j\}=\frac12(\tilde A^TI^{-1})_{ij}=\frac12[-\epsilon_{ikp}n_p+\delta_{ik}+n_i n_k]I^{-1}_{kj},  \quad ~ \cr"
+        + "\n"
+        + r"\{\Omega_i, \Omega_j\}=\frac{-1}{1+{\bf n}^2}(I^{-1})_{ia}(I^{-1})_{jb}\left[\epsilon_{abc}(I\Omega)_c+(\hat n_{ab}n_c+cycle \, (abc)\,)(I\Omega)_c\right].",
         note="Canonical brackets rewritten with $\\boldsymbol\\pi = 2AI\\boldsymbol\\Omega$; general symmetric $I$. With the cyclic sum $=\\mathbf n^2\\epsilon_{abc}$ the second bracket collapses.",
         checks=(
             CheckSpec(label="{n_i, n_j}", frame="nOmega", index="ij", printed="0", derived="PBnn"),
@@ -1061,8 +1118,18 @@ ENTRIES: tuple[EntrySpec, ...] = (
         note="Pfaffian in $(\\mathbf n,\\boldsymbol\\Omega)$: $-(1+\\mathbf n^2)^2/(8\\det I)$; linearised brackets compared with $e(3)$ with $\\mathbf J = -I\\boldsymbol\\Omega$ (the sign that matches $\\{J_i,J_j\\}=\\epsilon_{ijk}J_k$), $\\mathbf P = \\mathbf n$; same for $(\\mathbf n,\\mathbf M)$ with $\\mathbf J=-\\mathbf M$. General symmetric $I$.",
         checks=(
             CheckSpec(label="Pfaffian (n, Omega)", frame="nOmega", kind="claim", printed="nonzero(pfaffian(P))"),
-            CheckSpec(label="linearised (n, Omega) minus e(3)", frame="nOmega", kind="claim", printed="nonzero_matrix(e3_difference('nOmega'))"),
-            CheckSpec(label="linearised (n, M) minus e(3)", frame="nM", kind="claim", printed="nonzero_matrix(e3_difference('nM'))"),
+            CheckSpec(
+                label="linearised (n, Omega) minus e(3)",
+                frame="nOmega",
+                kind="claim",
+                printed="nonzero_matrix(e3_difference('nOmega'))",
+            ),
+            CheckSpec(
+                label="linearised (n, M) minus e(3)",
+                frame="nM",
+                kind="claim",
+                printed="nonzero_matrix(e3_difference('nM'))",
+            ),
         ),
     ),
     EntrySpec(

@@ -78,8 +78,11 @@ __all__ = ["HeavyTopDerivation", "derive_heavy_top", "HeavyTopCheck", "check_hea
 
 
 def _cross(u, v):
-    return [(u[1] * v[2] - u[2] * v[1]).normalize(), (u[2] * v[0] - u[0] * v[2]).normalize(),
-            (u[0] * v[1] - u[1] * v[0]).normalize()]
+    return [
+        (u[1] * v[2] - u[2] * v[1]).normalize(),
+        (u[2] * v[0] - u[0] * v[2]).normalize(),
+        (u[0] * v[1] - u[1] * v[0]).normalize(),
+    ]
 
 
 def _rdot(ctx, u, v):
@@ -619,8 +622,9 @@ def _random_point(rng):
     return n, pi, inertia, mass, c, g
 
 
-def check_heavy_top(points: int = 3, seed: int = 0, *, inertia: str = "general", tol: float = 1e-12,
-                    identities: bool = True) -> HeavyTopCheck:
+def check_heavy_top(
+    points: int = 3, seed: int = 0, *, inertia: str = "general", tol: float = 1e-12, identities: bool = True
+) -> HeavyTopCheck:
     r"""Compare the derived heavy top with the numeric canonical formulation.
 
     Checks the identities of :meth:`HeavyTopDerivation.identities` exactly
@@ -667,10 +671,14 @@ def check_heavy_top(points: int = 3, seed: int = 0, *, inertia: str = "general",
         if inertia == "diagonal":
             I = [[I[i][j] if i == j else Fraction(0) for j in range(3)] for i in range(3)]
         derived = d.evaluate(n, pi, I, mass, c, g)
-        f = formulation("canonical", np.array(I, dtype=float),
-                        torque=Gravity(float(mass), [float(x) for x in c], [float(x) for x in g]))
+        f = formulation(
+            "canonical",
+            np.array(I, dtype=float),
+            torque=Gravity(float(mass), [float(x) for x in c], [float(x) for x in g]),
+        )
         numeric = f.vector_field(np.array([float(x) for x in n + pi]))
         worst = max(worst, float(np.max(np.abs(derived - numeric) / np.maximum(1.0, np.abs(numeric)))))
     ids = d.identities() if identities else {}
-    return HeavyTopCheck(identities=ids, max_difference=worst, points=int(points),
-                         passed=all(ids.values()) and worst <= tol)
+    return HeavyTopCheck(
+        identities=ids, max_difference=worst, points=int(points), passed=all(ids.values()) and worst <= tol
+    )

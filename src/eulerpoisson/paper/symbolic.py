@@ -152,9 +152,7 @@ def cross(u, v):
     sympy.Matrix, shape (3, 1)
     """
     sp = _sympy()
-    return sp.Matrix(
-        3, 1, lambda i, _: sum(levi_civita(i, j, k) * u[j] * v[k] for j in range(3) for k in range(3))
-    )
+    return sp.Matrix(3, 1, lambda i, _: sum(levi_civita(i, j, k) * u[j] * v[k] for j in range(3) for k in range(3)))
 
 
 def dot(u, v):
@@ -182,10 +180,7 @@ def cyclic_tensor(v):
         ``T[i][j][k]`` as SymPy expressions.
     """
     h = hat(v)
-    return [
-        [[h[i, j] * v[k] + h[j, k] * v[i] + h[k, i] * v[j] for k in range(3)] for j in range(3)]
-        for i in range(3)
-    ]
+    return [[[h[i, j] * v[k] + h[j, k] * v[i] + h[k, i] * v[j] for k in range(3)] for j in range(3)] for i in range(3)]
 
 
 # ---------------------------------------------------------------------------
@@ -262,7 +257,9 @@ def inverse3(M):
     """
     sp = _sympy()
     if not isinstance(M, sp.MatrixBase) or M.shape != (3, 3):
-        raise InvalidInputError(f"inverse3: M must be a sympy Matrix of shape (3, 3), got {getattr(M, 'shape', type(M))}")
+        raise InvalidInputError(
+            f"inverse3: M must be a sympy Matrix of shape (3, 3), got {getattr(M, 'shape', type(M))}"
+        )
     syms = set()
     for e in M:
         syms |= sp.sympify(e).free_symbols
@@ -862,8 +859,14 @@ class Derivation:
         self.detI = sp.expand(self.I.det())
         self.nsq = dot(self.n, self.n)
         gens = (
-            list(self.n) + list(self.ndot) + list(self.nddot) + list(self.pi) + list(self.m_sym)
-            + list(self.Omega_sym) + list(self.M_sym) + list(self.inertia_symbols)
+            list(self.n)
+            + list(self.ndot)
+            + list(self.nddot)
+            + list(self.pi)
+            + list(self.m_sym)
+            + list(self.Omega_sym)
+            + list(self.M_sym)
+            + list(self.inertia_symbols)
         )
         known = [1 + self.nsq] + ([self.detI] if inertia == "general" else list(self.inertia_symbols))
         self.ctx = _Ctx(gens, known)
@@ -915,7 +918,10 @@ class Derivation:
 
     def _fRdot(self):
         return [
-            [_rsum((self._fR[i][j].diff(self.n[l]) * self._fnd[l] for l in range(3)), self.ctx).normalize() for j in range(3)]
+            [
+                _rsum((self._fR[i][j].diff(self.n[l]) * self._fnd[l] for l in range(3)), self.ctx).normalize()
+                for j in range(3)
+            ]
             for i in range(3)
         ]
 
@@ -923,7 +929,13 @@ class Derivation:
         sp = _sympy()
         half = self.ctx.from_expr(sp.Rational(-1, 2))
         return [
-            (_rsum((W[i][j] * levi_civita(k, i, j) for i in range(3) for j in range(3) if levi_civita(k, i, j)), self.ctx) * half).normalize()
+            (
+                _rsum(
+                    (W[i][j] * levi_civita(k, i, j) for i in range(3) for j in range(3) if levi_civita(k, i, j)),
+                    self.ctx,
+                )
+                * half
+            ).normalize()
             for k in range(3)
         ]
 
@@ -970,7 +982,9 @@ class Derivation:
     def _fL(self):
         half = self.ctx.from_expr(_sympy().Rational(1, 2))
         Om = self._fOmega_v
-        return (_rsum((self._fI[i][j] * Om[i] * Om[j] for i in range(3) for j in range(3)), self.ctx) * half).normalize()
+        return (
+            _rsum((self._fI[i][j] * Om[i] * Om[j] for i in range(3) for j in range(3)), self.ctx) * half
+        ).normalize()
 
     @cached_property
     def L(self):
@@ -1027,7 +1041,10 @@ class Derivation:
         G1 = self._fchristoffel_first
         Gi = self._fGinv
         return [
-            [[_rsum((Gi[i][l] * G1[l][j][k] for l in range(3)), self.ctx).normalize() for k in range(3)] for j in range(3)]
+            [
+                [_rsum((Gi[i][l] * G1[l][j][k] for l in range(3)), self.ctx).normalize() for k in range(3)]
+                for j in range(3)
+            ]
             for i in range(3)
         ]
 
@@ -1061,7 +1078,9 @@ class Derivation:
         G2 = self._fchristoffel_second
         nd = self._fnd
         return [
-            (self._fndd[i] + _rsum((G2[i][j][k] * nd[j] * nd[k] for j in range(3) for k in range(3)), self.ctx)).normalize()
+            (
+                self._fndd[i] + _rsum((G2[i][j][k] * nd[j] * nd[k] for j in range(3) for k in range(3)), self.ctx)
+            ).normalize()
             for i in range(3)
         ]
 
@@ -1187,9 +1206,7 @@ class Derivation:
         if chart == "canonical":
             return fexpr
         if chart not in ("nm", "nOmega", "nM"):
-            raise InvalidInputError(
-                f"chart must be one of 'canonical', 'nm', 'nOmega', 'nM', got {chart!r}"
-            )
+            raise InvalidInputError(f"chart must be one of 'canonical', 'nm', 'nOmega', 'nM', got {chart!r}")
         mapping = dict(zip(self.pi, self._fpi_of[chart]))
         if isinstance(fexpr, list):
             return self.ctx.subs_all(fexpr, mapping)
@@ -1794,8 +1811,13 @@ def check_lie_series(order: int, inertia, pi0, n0=None, times: ArrayLike | None 
         raise InvalidInputError(f"times must be >= 2 positive finite values, got {times!r}")
     ts = np.sort(times)
     sol = solve_ivp(
-        lambda _t, z: hamilton_rhs(z, Kf), (0.0, float(ts[-1])), z0, method="DOP853",
-        t_eval=ts, rtol=1e-13, atol=1e-15,
+        lambda _t, z: hamilton_rhs(z, Kf),
+        (0.0, float(ts[-1])),
+        z0,
+        method="DOP853",
+        t_eval=ts,
+        rtol=1e-13,
+        atol=1e-15,
     )
     if not sol.success:  # pragma: no cover - solver failure
         raise InvalidInputError(f"reference integration failed: {sol.message}")

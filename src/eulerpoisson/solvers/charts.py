@@ -496,8 +496,7 @@ def check_step_budget(method: str, t, steps_per_unit_time: float, max_steps: int
         need = span * float(steps_per_unit_time)
     if span > 0 and not (need <= max_steps):  # also catches inf and nan
         raise InvalidInputError(
-            f"{method}: reaching |t| = {span:.6g} needs about {need:.3g} steps, more than max_steps={max_steps}; "
-            f"{hint}"
+            f"{method}: reaching |t| = {span:.6g} needs about {need:.3g} steps, more than max_steps={max_steps}; {hint}"
         )
 
 

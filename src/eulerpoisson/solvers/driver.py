@@ -34,8 +34,19 @@ if TYPE_CHECKING:
 __all__ = ["solve"]
 
 
-def solve(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLike | None = None, m0: ArrayLike | None = None, attitude0: AttitudeLike | None = None, gibbs0: ArrayLike | None = None, torque: TorqueLike = None, method: str | MethodOptions = "exact", workers: int | None = None,
-          **options: Any) -> Trajectory:
+def solve(
+    body: RigidBody | Model | ArrayLike,
+    t: ArrayLike,
+    *,
+    omega0: ArrayLike | None = None,
+    m0: ArrayLike | None = None,
+    attitude0: AttitudeLike | None = None,
+    gibbs0: ArrayLike | None = None,
+    torque: TorqueLike = None,
+    method: str | MethodOptions = "exact",
+    workers: int | None = None,
+    **options: Any,
+) -> Trajectory:
     r"""Motion of rigid bodies, free or under torque, at the output times ``t``.
 
     Parameters
@@ -136,7 +147,8 @@ def solve(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLik
 
         warnings.warn(
             f"the initial state is given in long double; method {method!r} computes in float64 and rounds it "
-            f"(method='taylor' with precision='longdouble' keeps it)", stacklevel=2,
+            f"(method='taylor' with precision='longdouble' keeps it)",
+            stacklevel=2,
         )
     if not cls.negative_times and np.any(problem.t < 0):
         raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
@@ -159,8 +171,6 @@ def solve(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLik
     return tr
 
 
-
-
 #: the keyword arguments of :func:`solve` itself
 _SOLVE_ARGUMENTS = ("omega0", "m0", "attitude0", "gibbs0", "torque", "method", "workers")
 
@@ -179,11 +189,14 @@ def _check_keywords(cls, options) -> None:
         owners = sorted(name for name, opts in every.items() if key in opts)
         if owners:
             have = ", ".join(sorted(own)) or "none"
-            raise TypeError(f"method {cls.name!r} has no option {key!r} (an option of {', '.join(owners)}); "
-                            f"its options: {have}")
+            raise TypeError(
+                f"method {cls.name!r} has no option {key!r} (an option of {', '.join(owners)}); its options: {have}"
+            )
         known = list(_SOLVE_ARGUMENTS) + sorted(own)
         close = difflib.get_close_matches(key, known + sorted(set().union(*every.values())), n=1)
         hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise TypeError(f"solve() got an unexpected keyword argument {key!r}{hint}; arguments: "
-                        f"{', '.join(_SOLVE_ARGUMENTS)}, and the options of method {cls.name!r}: "
-                        f"{', '.join(sorted(own)) or 'none'}")
+        raise TypeError(
+            f"solve() got an unexpected keyword argument {key!r}{hint}; arguments: "
+            f"{', '.join(_SOLVE_ARGUMENTS)}, and the options of method {cls.name!r}: "
+            f"{', '.join(sorted(own)) or 'none'}"
+        )

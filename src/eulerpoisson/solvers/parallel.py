@@ -157,8 +157,10 @@ def check_workers(workers, name: str = "workers") -> int | None:
     if workers is None:
         return None
     if isinstance(workers, (bool, np.bool_)) or not isinstance(workers, numbers.Integral):
-        raise TypeError(f"{name} must be a whole number of threads >= 1, or None for every core; "
-                        f"got {type(workers).__name__} {workers!r}")
+        raise TypeError(
+            f"{name} must be a whole number of threads >= 1, or None for every core; "
+            f"got {type(workers).__name__} {workers!r}"
+        )
     if workers < 1:
         raise InvalidInputError(f"{name} must be >= 1 (1: one thread), or None for every core; got {workers!r}")
     return int(workers)
@@ -182,8 +184,10 @@ def resolve_workers(workers=None) -> int:
         except ValueError:
             value = None
         if value is None or value < 1:
-            raise InvalidInputError(f"the environment variable {ENV_WORKERS} must be a whole number of threads "
-                                    f">= 1 (or unset: every core); got {env!r}")
+            raise InvalidInputError(
+                f"the environment variable {ENV_WORKERS} must be a whole number of threads "
+                f">= 1 (or unset: every core); got {env!r}"
+            )
         return value
     return available_cores()
 
@@ -215,9 +219,10 @@ def plan_chunks(n_bodies: int, workers: int, work: float) -> list[tuple[int, int
 def _sub_index(shape: tuple[int, ...], index: tuple) -> tuple:
     """Index into an array of batch ``shape`` (right-aligned, broadcasting) from an index of the full batch."""
     k = len(shape)
-    tail = index[len(index) - k:] if k else ()
-    return tuple((slice(None) if isinstance(i, slice) else np.zeros_like(i)) if n == 1 else i
-                 for i, n in zip(tail, shape))
+    tail = index[len(index) - k :] if k else ()
+    return tuple(
+        (slice(None) if isinstance(i, slice) else np.zeros_like(i)) if n == 1 else i for i, n in zip(tail, shape)
+    )
 
 
 def take(problem: Problem, start: int, stop: int) -> Problem:
@@ -238,7 +243,7 @@ def take(problem: Problem, start: int, stop: int) -> Problem:
     if body.batch_shape:
         body = body[_sub_index(body.batch_shape, index)]
     torques = [tq[_sub_index(tq.batch_shape, index)] if tq.batch_shape else tq for tq in model.torques]
-    extended = {k: v.reshape((-1,) + v.shape[len(shape):])[start:stop] for k, v in problem.extended.items()}
+    extended = {k: v.reshape((-1,) + v.shape[len(shape) :])[start:stop] for k, v in problem.extended.items()}
     return Problem(
         model=Model(body, torques),
         q0=problem.q0.reshape(-1, 4)[start:stop],
@@ -347,8 +352,9 @@ def _run_threads(method: Method, problem: Problem, bounds: list[tuple[int, int]]
         raise
     if failed:
         raise failed[0]
-    return MethodResult(q=q.reshape(shape + (T, 4)), omega=w.reshape(shape + (T, 3)),
-                        stats=_merge_stats(method, stats), prepared=True)
+    return MethodResult(
+        q=q.reshape(shape + (T, 4)), omega=w.reshape(shape + (T, 3)), stats=_merge_stats(method, stats), prepared=True
+    )
 
 
 def solve_batch(method: Method, problem: Problem, workers: int | None = None) -> MethodResult:

@@ -138,7 +138,16 @@ def initial_quaternion(attitude0: AttitudeLike | None = None, gibbs0: ArrayLike 
     return as_quaternion(q0, "attitude0")
 
 
-def make_problem(body: RigidBody | Model | ArrayLike, t: ArrayLike, *, omega0: ArrayLike | None = None, m0: ArrayLike | None = None, attitude0: AttitudeLike | None = None, gibbs0: ArrayLike | None = None, torque: TorqueLike = None) -> Problem:
+def make_problem(
+    body: RigidBody | Model | ArrayLike,
+    t: ArrayLike,
+    *,
+    omega0: ArrayLike | None = None,
+    m0: ArrayLike | None = None,
+    attitude0: AttitudeLike | None = None,
+    gibbs0: ArrayLike | None = None,
+    torque: TorqueLike = None,
+) -> Problem:
     """Validate and broadcast the arguments of :func:`solve` into a :class:`Problem`.
 
     Raises

@@ -372,9 +372,5 @@ def get_method(name: str) -> type[Method]:
     unknown method 'euler'; available methods: exact, rk, ...
     """
     if not isinstance(name, str) or name not in _REGISTRY:
-        raise InvalidInputError(
-            f"unknown method {name!r}; available methods: {', '.join(sorted(_REGISTRY))}"
-        )
+        raise InvalidInputError(f"unknown method {name!r}; available methods: {', '.join(sorted(_REGISTRY))}")
     return _REGISTRY[name]
-
-

@@ -318,9 +318,13 @@ def _check_scheduler(s, where: str) -> str:
     import re
 
     if not isinstance(s, str) or not (s in ("local", "serial") or s.startswith(("tcp://", "tls://"))):
-        raise InvalidInputError(f"{where} must be 'local', 'serial' or a scheduler address 'tcp://HOST:PORT', got {s!r}")
+        raise InvalidInputError(
+            f"{where} must be 'local', 'serial' or a scheduler address 'tcp://HOST:PORT', got {s!r}"
+        )
     if s.startswith(("tcp://", "tls://")) and not re.fullmatch(r"(tcp|tls)://(\[[0-9a-fA-F:.]+\]|[^:/\s]+):\d{1,5}", s):
-        raise InvalidInputError(f"{where} {s!r} must name a host and a port: 'tcp://HOST:PORT' (e.g. tcp://127.0.0.1:8786)")
+        raise InvalidInputError(
+            f"{where} {s!r} must name a host and a port: 'tcp://HOST:PORT' (e.g. tcp://127.0.0.1:8786)"
+        )
     return s
 
 
@@ -434,7 +438,7 @@ def load_config(source) -> SweepConfig:
     polar = _axis_spec(mo["polar"], f"{name}: [momentum] polar", kind, False)
     azimuth = _axis_spec(mo["azimuth"], f"{name}: [momentum] azimuth", kind, False)
     top = 180.0 if degrees else math.pi
-    for v in (_grid_values(polar) if "values" in polar else [polar["range"]["start"], polar["range"]["stop"]]):
+    for v in _grid_values(polar) if "values" in polar else [polar["range"]["start"], polar["range"]["stop"]]:
         if not (0.0 <= v <= top):
             raise InvalidInputError(f"{name}: [momentum] polar must lie in [0, {top:g}], got {v!r}")
     magnitude = _real(mo.get("magnitude", 1.0), f"{name}: [momentum] magnitude", positive=True)
@@ -449,7 +453,9 @@ def load_config(source) -> SweepConfig:
     T = _real(co["T"], f"{name}: [compute] T", positive=True)
     delta = _real(co.get("delta", 1e-6), f"{name}: [compute] delta", positive=True)
     if not delta < 0.1:
-        raise InvalidInputError(f"{name}: [compute] delta must be a small angle in radians, 0 < delta < 0.1, got {delta!r}")
+        raise InvalidInputError(
+            f"{name}: [compute] delta must be a small angle in radians, 0 < delta < 0.1, got {delta!r}"
+        )
     scheduler = _check_scheduler(co.get("scheduler", "local"), f"{name}: [compute] scheduler")
     workers = co.get("workers")
     if workers is not None:
@@ -464,9 +470,22 @@ def load_config(source) -> SweepConfig:
             f"{name}: [compute] method: unknown method {method!r}; available: {', '.join(available_methods())}"
         )
     return SweepConfig(
-        kind=kind, samples=samples, seed=seed, inertia=inertia, polar=polar, azimuth=azimuth,
-        magnitude=magnitude, degrees=degrees, path=path, chunk=chunk, T=T, delta=delta,
-        scheduler=scheduler, workers=workers, method=method, source=name,
+        kind=kind,
+        samples=samples,
+        seed=seed,
+        inertia=inertia,
+        polar=polar,
+        azimuth=azimuth,
+        magnitude=magnitude,
+        degrees=degrees,
+        path=path,
+        chunk=chunk,
+        T=T,
+        delta=delta,
+        scheduler=scheduler,
+        workers=workers,
+        method=method,
+        source=name,
     )
 
 
@@ -661,14 +680,28 @@ def _compute_chunk(inertia, M0, T, delta, method, run_points=0, workers=None):
 # running a sweep
 # ---------------------------------------------------------------------------
 _RESULTS: dict[str, tuple[str, dict[str, Any]]] = {
-    "half_period": ("f8", {"long_name": "flip half-period 2K(k)/lambda (time between flips); inf on the separatrix",
-                           "units": "s"}),
+    "half_period": (
+        "f8",
+        {"long_name": "flip half-period 2K(k)/lambda (time between flips); inf on the separatrix", "units": "s"},
+    ),
     "k2": ("f8", {"long_name": "Jacobi parameter k^2 of the polhode", "units": "1"}),
-    "sensitivity": ("f8", {"long_name": "attitude sensitivity: rotation angle between the attitudes at T of "
-                                        "initial momenta differing by delta, divided by delta", "units": "1"}),
-    "status": ("i1", {"long_name": "0 regular, 1 separatrix, 2 symmetric body, 3 not a physical body",
-                      "units": "1", "flag_values": [0, 1, 2, 3],
-                      "flag_meanings": "regular separatrix symmetric_body not_physical"}),
+    "sensitivity": (
+        "f8",
+        {
+            "long_name": "attitude sensitivity: rotation angle between the attitudes at T of "
+            "initial momenta differing by delta, divided by delta",
+            "units": "1",
+        },
+    ),
+    "status": (
+        "i1",
+        {
+            "long_name": "0 regular, 1 separatrix, 2 symmetric body, 3 not a physical body",
+            "units": "1",
+            "flag_values": [0, 1, 2, 3],
+            "flag_meanings": "regular separatrix symmetric_body not_physical",
+        },
+    ),
 }
 
 
@@ -679,22 +712,24 @@ def _create_store(zarr, store: Path, cfg: SweepConfig) -> None:
     from .. import __version__
 
     g = zarr.open_group(str(store), mode="w")
-    g.attrs.update({
-        "title": f"eulerpoisson sweep: tennis-racket stability atlas ({cfg.kind})",
-        "Conventions": "CF-1.10",
-        "eulerpoisson_version": __version__,
-        "sweep_format_version": _FORMAT_VERSION,
-        "sweep_config": json.dumps(cfg.fingerprint(), sort_keys=True),
-        "sweep_kind": cfg.kind,
-        "sweep_grid": json.dumps({k: v.tolist() for k, v in cfg.grid_axes.items()}) if cfg.kind == "grid" else "{}",
-        "sweep_axes": json.dumps(cfg.axis_names),
-        "n_points": n,
-        "chunk": chunk,
-        "T": cfg.T,
-        "delta": cfg.delta,
-        "method": cfg.method,
-        "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} started by eulerpoisson {__version__}",
-    })
+    g.attrs.update(
+        {
+            "title": f"eulerpoisson sweep: tennis-racket stability atlas ({cfg.kind})",
+            "Conventions": "CF-1.10",
+            "eulerpoisson_version": __version__,
+            "sweep_format_version": _FORMAT_VERSION,
+            "sweep_config": json.dumps(cfg.fingerprint(), sort_keys=True),
+            "sweep_kind": cfg.kind,
+            "sweep_grid": json.dumps({k: v.tolist() for k, v in cfg.grid_axes.items()}) if cfg.kind == "grid" else "{}",
+            "sweep_axes": json.dumps(cfg.axis_names),
+            "n_points": n,
+            "chunk": chunk,
+            "T": cfg.T,
+            "delta": cfg.delta,
+            "method": cfg.method,
+            "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} started by eulerpoisson {__version__}",
+        }
+    )
 
     def arr(name, dims, shape, chunks, dtype, attrs, fill):
         a = g.create_array(name, shape=shape, chunks=chunks, dtype=dtype, fill_value=fill, dimension_names=dims)
@@ -711,18 +746,38 @@ def _create_store(zarr, store: Path, cfg: SweepConfig) -> None:
     }
     for name, attrs in params.items():
         arr(name, ["point"], (n,), (c,), "f8", attrs, np.nan)
-    arr("M0", ["point", "axis"], (n, 3), (c, 3), "f8",
-        {"long_name": "initial body angular momentum (principal frame)", "units": "kg m2 s-1"}, np.nan)
+    arr(
+        "M0",
+        ["point", "axis"],
+        (n, 3),
+        (c, 3),
+        "f8",
+        {"long_name": "initial body angular momentum (principal frame)", "units": "kg m2 s-1"},
+        np.nan,
+    )
     ax = arr("axis", ["axis"], (3,), (3,), "<U1", {}, "")
     ax[...] = np.array(["x", "y", "z"])
     for name, (dtype, attrs) in _RESULTS.items():
         arr(name, ["point"], (n,), (c,), dtype, attrs, np.nan if dtype == "f8" else -1)
-    arr("chunk_count", ["chunk"], (nchunks,), (1,), "i4",
-        {"long_name": "times this chunk was computed and written"}, 0)
-    arr("chunk_time", ["chunk"], (nchunks,), (1,), "f8",
-        {"long_name": "time the chunk was written", "units": "seconds since 1970-01-01 00:00:00 UTC"}, np.nan)
-    arr("chunk_seconds", ["chunk"], (nchunks,), (1,), "f8",
-        {"long_name": "compute time of the chunk", "units": "s"}, np.nan)
+    arr("chunk_count", ["chunk"], (nchunks,), (1,), "i4", {"long_name": "times this chunk was computed and written"}, 0)
+    arr(
+        "chunk_time",
+        ["chunk"],
+        (nchunks,),
+        (1,),
+        "f8",
+        {"long_name": "time the chunk was written", "units": "seconds since 1970-01-01 00:00:00 UTC"},
+        np.nan,
+    )
+    arr(
+        "chunk_seconds",
+        ["chunk"],
+        (nchunks,),
+        (1,),
+        "f8",
+        {"long_name": "compute time of the chunk", "units": "s"},
+        np.nan,
+    )
 
     # the parameters of every point, written once, in slabs of whole chunks (<= ~2.6e5 points)
     if cfg.kind == "random":
@@ -744,7 +799,11 @@ def _local_cluster(workers):
     n = workers or os.cpu_count() or 1
     # everything on the loopback interface: no scheduler or dashboard port open to the network
     return distributed.LocalCluster(
-        n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address="127.0.0.1:0",
+        n_workers=n,
+        threads_per_worker=1,
+        processes=True,
+        host="127.0.0.1",
+        dashboard_address="127.0.0.1:0",
         silence_logs=logging.ERROR,
     )
 
@@ -863,7 +922,9 @@ def run_sweep(
                 same = False
             if same:
                 return path
-            raise FileExistsError(f"{path} exists and holds a different sweep (or no sweep); pass overwrite=True to replace it")
+            raise FileExistsError(
+                f"{path} exists and holds a different sweep (or no sweep); pass overwrite=True to replace it"
+            )
 
     work = _work_dir(path)
     store = work / "store.zarr"
@@ -891,8 +952,9 @@ def run_sweep(
 
     with _quiet_zarr():
         g = zarr.open_group(str(store), mode="r+")
-        arrs = {name: g[name] for name in ("I1", "I2", "I3", "M0", *_RESULTS, "chunk_count", "chunk_seconds",
-                                           "chunk_time")}
+        arrs = {
+            name: g[name] for name in ("I1", "I2", "I3", "M0", *_RESULTS, "chunk_count", "chunk_seconds", "chunk_time")
+        }
     n, chunk = cfg.n_points, cfg.chunk
     nchunks = -(-n // chunk)
     todo = [k for k in range(nchunks) if k not in done]
@@ -935,9 +997,7 @@ def run_sweep(
         raise
 
     with _quiet_zarr():
-        g.attrs["history"] = (
-            f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
-        )
+        g.attrs["history"] = f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
         zarr.consolidate_metadata(str(store))
     _replace_dir(store, path, overwrite)
     shutil.rmtree(work, ignore_errors=True)
@@ -1036,7 +1096,9 @@ def load_sweep(path, *, squeeze: bool = True):
     p = Path(path)
     if not p.exists():
         work = _work_dir(p)
-        hint = f"; an unfinished sweep is in {work / 'store.zarr'} (rerun the sweep to finish it)" if work.exists() else ""
+        hint = (
+            f"; an unfinished sweep is in {work / 'store.zarr'} (rerun the sweep to finish it)" if work.exists() else ""
+        )
         raise FileNotFoundError(f"no sweep store at {p}{hint}")
     try:
         with _quiet_zarr():
@@ -1170,8 +1232,9 @@ def plot_atlas(ds, out, *, variables=("half_period", "sensitivity"), dpi: int = 
             pc = ax.pcolormesh(xv, yv, zm, norm=LogNorm(), cmap=cmap, shading="nearest")
             inf = np.isinf(z)
             if inf.any():
-                ax.pcolormesh(xv, yv, np.ma.masked_where(~inf, np.ones_like(z)), cmap="Greys", vmin=0, vmax=2,
-                              shading="nearest")
+                ax.pcolormesh(
+                    xv, yv, np.ma.masked_where(~inf, np.ones_like(z)), cmap="Greys", vmin=0, vmax=2, shading="nearest"
+                )
             gz = _as_plane(ds, gap, yd, xd)
             crosses = bool(np.nanmin(gz) < 0 < np.nanmax(gz)) if np.isfinite(gz).any() else False
             if crosses:

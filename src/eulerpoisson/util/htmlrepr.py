@@ -46,10 +46,12 @@ STORED_BUDGET = 1_000_000
 COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728")
 
 #: one style sheet per view, scoped by its class (cells carry no style of their own: smaller pages)
-_STYLE = ("<style>.eulerpoisson-repr table{border-collapse:collapse;font-size:12px;margin:2px 0}"
-          ".eulerpoisson-repr th,.eulerpoisson-repr td{padding:1px 8px;text-align:left;vertical-align:top;"
-          "border-bottom:1px solid #ddd}.eulerpoisson-repr caption{text-align:left;font-weight:bold}"
-          ".eulerpoisson-repr .note{font-size:11px;color:#555}</style>")
+_STYLE = (
+    "<style>.eulerpoisson-repr table{border-collapse:collapse;font-size:12px;margin:2px 0}"
+    ".eulerpoisson-repr th,.eulerpoisson-repr td{padding:1px 8px;text-align:left;vertical-align:top;"
+    "border-bottom:1px solid #ddd}.eulerpoisson-repr caption{text-align:left;font-weight:bold}"
+    ".eulerpoisson-repr .note{font-size:11px;color:#555}</style>"
+)
 
 
 class Raw(str):
@@ -94,8 +96,10 @@ def table(title, rows, extra: str = "") -> Raw:
     :class:`Raw` (markup built here). ``extra`` (markup) follows the table.
     """
     body = "".join(f"<tr><th>{_cell(k)}</th><td>{_cell(v)}</td></tr>" for k, v in rows)
-    return Raw(f'<div class="eulerpoisson-repr">{_STYLE}<table><caption>{_cell(title)}</caption>'
-               f"<tbody>{body}</tbody></table>{extra}</div>")
+    return Raw(
+        f'<div class="eulerpoisson-repr">{_STYLE}<table><caption>{_cell(title)}</caption>'
+        f"<tbody>{body}</tbody></table>{extra}</div>"
+    )
 
 
 def grid(header, rows) -> Raw:
@@ -108,8 +112,17 @@ def grid(header, rows) -> Raw:
 # ---------------------------------------------------------------------------
 # inline pictures
 # ---------------------------------------------------------------------------
-def sparkline_svg(t, series, labels=(), *, title: str = "", columns: int = SPARK_COLUMNS,
-                  width: int = SPARK_WIDTH, height: int = SPARK_HEIGHT, colors=COLORS) -> Raw:
+def sparkline_svg(
+    t,
+    series,
+    labels=(),
+    *,
+    title: str = "",
+    columns: int = SPARK_COLUMNS,
+    width: int = SPARK_WIDTH,
+    height: int = SPARK_HEIGHT,
+    colors=COLORS,
+) -> Raw:
     """A small SVG line picture of ``series`` (k arrays of the times ``t``), one colour each (``colors``).
 
     Decimated to ``columns`` columns, each drawn through the minimum and the
@@ -150,15 +163,14 @@ def sparkline_svg(t, series, labels=(), *, title: str = "", columns: int = SPARK
         py = height - pad - (y[:, j] - lo) * scale if hi > lo else np.full(x.shape, height / 2.0)
         keep = np.isfinite(py)
         pts = " ".join(f"{a:.1f},{b:.1f}" for a, b in zip(px[keep], py[keep]))
-        parts.append(f'<polyline fill="none" stroke="{colors[j % len(colors)]}" stroke-width="1" '
-                     f'points="{pts}"/>')
+        parts.append(f'<polyline fill="none" stroke="{colors[j % len(colors)]}" stroke-width="1" points="{pts}"/>')
     tip = f"<title>{esc(title)}</title>" if title else ""
-    svg = (f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
-           f'viewBox="0 0 {width} {height}" role="img" style="background:#fafafa">{tip}{"".join(parts)}</svg>')
-    keys = " ".join(f'<span style="color:{colors[j % len(colors)]}">{esc(lab)}</span>'
-                    for j, lab in enumerate(labels))
-    note = (f'<div class="note">{keys} in [{esc(num(lo))}, {esc(num(hi))}], '
-            f't in [{esc(num(t0))}, {esc(num(t1))}]</div>')
+    svg = (
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" '
+        f'viewBox="0 0 {width} {height}" role="img" style="background:#fafafa">{tip}{"".join(parts)}</svg>'
+    )
+    keys = " ".join(f'<span style="color:{colors[j % len(colors)]}">{esc(lab)}</span>' for j, lab in enumerate(labels))
+    note = f'<div class="note">{keys} in [{esc(num(lo))}, {esc(num(hi))}], t in [{esc(num(t0))}, {esc(num(t1))}]</div>'
     return Raw(f'<div style="margin:2px 0">{svg}{note}</div>')
 
 
@@ -241,8 +253,11 @@ def _pictures(tr, label: str) -> Raw:
     if E is not None and E.size:
         E0 = float(E[0])
         rel = (E - E0) / abs(E0) if E0 != 0 else E - E0
-        pics.append(sparkline_svg(t, [rel], ("(E − E0)/|E0|" if E0 != 0 else "E − E0",),
-                                  title=f"energy change{label}", colors=COLORS[3:]))
+        pics.append(
+            sparkline_svg(
+                t, [rel], ("(E − E0)/|E0|" if E0 != 0 else "E − E0",), title=f"energy change{label}", colors=COLORS[3:]
+            )
+        )
     return Raw("".join(pics))
 
 
@@ -273,7 +288,7 @@ def trajectory_html(tr) -> Raw:
     rows.append(("samples", f"{T}" + (f" × {nb} bodies (batch shape {bshape})" if bshape else "")))
     if T:
         rows.append(("t", f"{num(tr.t[0])} → {num(tr.t[-1])}"))
-        rows.append(("|Ω|", span(np.sqrt(np.sum(tr.omega ** 2, -1)))))
+        rows.append(("|Ω|", span(np.sqrt(np.sum(tr.omega**2, -1)))))
     rows += body_rows(tr.body) + _torque_rows(tr.model)
     extra = ""
     if T:
@@ -314,8 +329,14 @@ def _stored_html(lz) -> Raw:
     rows = [("file", str(lz.path)), ("format", "Zarr store, read on demand"), ("method", lz.method or "?")]
     if lz.options:
         rows.append(("options", _options_text(lz.options)))
-    rows.append(("samples", f"{T}" + (f" × {int(np.prod(bshape))} bodies (batch shape {bshape})" if bshape else "")
-                 + f", chunks of {lz.chunk}"))
+    rows.append(
+        (
+            "samples",
+            f"{T}"
+            + (f" × {int(np.prod(bshape))} bodies (batch shape {bshape})" if bshape else "")
+            + f", chunks of {lz.chunk}",
+        )
+    )
     part, extra, drift = None, "", []
     if T:
         try:
@@ -337,11 +358,18 @@ def _stored_html(lz) -> Raw:
 def fit_html(res) -> Raw:
     """The view of a :class:`~eulerpoisson.FitResult`: the quality of the fit and the parameters with their errors."""
     kinds = ", ".join(f"{k} {len(v)}" for k, v in res.residuals.items() if not k.endswith("_t"))
-    rows = [("observations", kinds or "none"), ("epoch", num(res.epoch)),
-            ("chi2 / dof", f"{num(res.chi2)} / {res.dof} = {num(res.reduced_chi2)}"
-             + ("" if res.converged else " (NOT converged)")),
-            ("principal moments (trace 1)", vec(res.principal_moments)), ("motion", res.mode),
-            ("attitude0 (w, x, y, z)", vec(res.attitude0.as_quaternion())), ("omega0", vec(res.omega0))]
+    rows = [
+        ("observations", kinds or "none"),
+        ("epoch", num(res.epoch)),
+        (
+            "chi2 / dof",
+            f"{num(res.chi2)} / {res.dof} = {num(res.reduced_chi2)}" + ("" if res.converged else " (NOT converged)"),
+        ),
+        ("principal moments (trace 1)", vec(res.principal_moments)),
+        ("motion", res.mode),
+        ("attitude0 (w, x, y, z)", vec(res.attitude0.as_quaternion())),
+        ("omega0", vec(res.omega0)),
+    ]
     if res.sigma_estimated:
         rows.append(("sigma estimated", ", ".join(f"{k} {num(res.sigma[k])}" for k in res.sigma_estimated)))
     if not res.determined:
@@ -356,14 +384,27 @@ def audit_html(rep) -> Raw:
     """The view of an :class:`~eulerpoisson.paper.audit.AuditReport`: counts, misprints, then every entry."""
     summ = rep.summary()
     counts = ", ".join(f"{k} {v}" for k, v in summ["counts"].items())
-    rows = [("entries", f"{summ['total']}: {counts}"), ("run time", f"{num(rep.elapsed_s)} s"),
-            ("SymPy", rep.meta.get("sympy", "?")), ("seed", rep.meta.get("seed", "?"))]
+    rows = [
+        ("entries", f"{summ['total']}: {counts}"),
+        ("run time", f"{num(rep.elapsed_s)} s"),
+        ("SymPy", rep.meta.get("sympy", "?")),
+        ("seed", rep.meta.get("seed", "?")),
+    ]
     for m in summ["misprints"]:
         rows.append((f"misprint {m['equation']}", m["summary"] or m["title"] or ""))
     colour = {"confirmed": "#2ca02c", "misprint": "#d62728"}
-    entries = grid(("equation", "status", "method", "title"), [
-        (e.equation, Raw(f'<span style="color:{colour.get(e.status, "#555")}">{esc(e.status)}</span>'), e.method,
-         e.spec.title) for e in rep.entries])
+    entries = grid(
+        ("equation", "status", "method", "title"),
+        [
+            (
+                e.equation,
+                Raw(f'<span style="color:{colour.get(e.status, "#555")}">{esc(e.status)}</span>'),
+                e.method,
+                e.spec.title,
+            )
+            for e in rep.entries
+        ],
+    )
     integ = ""
     if rep.integrability:
         integ = esc(f"integrability: Jacobian rank {rep.integrability.get('jacobian_rank', '?')}")

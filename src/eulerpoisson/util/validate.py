@@ -51,7 +51,7 @@ def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite:
         raise TypeError(f"{name} must be real, got complex dtype {a.dtype}")
     a = a.astype(np.float64, copy=False)
     nt = len(tail)
-    if nt and (a.ndim < nt or a.shape[a.ndim - nt:] != tuple(tail)):
+    if nt and (a.ndim < nt or a.shape[a.ndim - nt :] != tuple(tail)):
         want = "(..., " + ", ".join(str(t) for t in tail) + ")"
         raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
     if not allow_nonfinite and not np.all(np.isfinite(a)):

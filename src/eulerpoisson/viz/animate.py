@@ -203,7 +203,7 @@ def _box_mesh(moments, axes):
 
 def _face_rgb(axis: int, sign: int) -> list[int]:
     h = AXIS_COLORS[axis].lstrip("#")
-    rgb = np.array([int(h[p:p + 2], 16) for p in (0, 2, 4)], float)
+    rgb = np.array([int(h[p : p + 2], 16) for p in (0, 2, 4)], float)
     if sign < 0:  # the face on the negative side: lighter
         rgb = rgb + 0.45 * (255.0 - rgb)
     return [int(round(c)) for c in rgb]
@@ -276,11 +276,12 @@ def _check_args(out, fps, duration, size):
         ext = "html"
     if ext not in FORMATS:
         raise InvalidInputError(
-            f"out={str(out)!r}: unsupported file extension {p.suffix!r}; use .html (self-contained page), "
-            ".gif or .mp4"
+            f"out={str(out)!r}: unsupported file extension {p.suffix!r}; use .html (self-contained page), .gif or .mp4"
         )
-    if isinstance(fps, bool) or not isinstance(fps, (int, float, np.integer, np.floating)) or not (
-        np.isfinite(fps) and fps > 0
+    if (
+        isinstance(fps, bool)
+        or not isinstance(fps, (int, float, np.integer, np.floating))
+        or not (np.isfinite(fps) and fps > 0)
     ):
         raise InvalidInputError(f"fps must be a positive number of frames per second, got {fps!r}")
     if duration is not None and (
@@ -305,8 +306,16 @@ def default_duration(span: float) -> float:
 # ---------------------------------------------------------------------------
 # public entry point
 # ---------------------------------------------------------------------------
-def animate(traj: Trajectory | LazyTrajectory, out: str | os.PathLike[str], *, fps: float = 30, duration: float | None = None, index: int | tuple[int, ...] = 0, size: tuple[int, int] = (640, 480),
-            max_samples: int = MAX_HTML_SAMPLES) -> Path:
+def animate(
+    traj: Trajectory | LazyTrajectory,
+    out: str | os.PathLike[str],
+    *,
+    fps: float = 30,
+    duration: float | None = None,
+    index: int | tuple[int, ...] = 0,
+    size: tuple[int, int] = (640, 480),
+    max_samples: int = MAX_HTML_SAMPLES,
+) -> Path:
     r"""Write an animation of the tumbling body: ``.html``, ``.gif`` or ``.mp4`` by the extension of ``out``.
 
     Parameters
@@ -725,8 +734,13 @@ class GifStreamWriter:
         import struct
 
         # logical screen without a global colour table (every frame has its own), then the loop extension
-        return (b"GIF89a" + struct.pack("<HHBBB", w, h, 0, 0, 0)
-                + b"!\xff\x0bNETSCAPE2.0\x03\x01" + struct.pack("<H", 0) + b"\x00")
+        return (
+            b"GIF89a"
+            + struct.pack("<HHBBB", w, h, 0, 0, 0)
+            + b"!\xff\x0bNETSCAPE2.0\x03\x01"
+            + struct.pack("<H", 0)
+            + b"\x00"
+        )
 
     def grab_frame(self, **savefig_kwargs):
         self.fig.canvas.draw()
@@ -758,7 +772,7 @@ class GifStreamWriter:
             cols = np.flatnonzero(diff.any(axis=0))
             box = (int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1)
         self._flush()
-        part = Image.fromarray(rgb[box[1]:box[3], box[0]:box[2]], "RGB")
+        part = Image.fromarray(rgb[box[1] : box[3], box[0] : box[2]], "RGB")
         pim = part.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
         self._pending = (pim, box[:2], duration)
         self._prev = rgb.copy()
@@ -860,10 +874,25 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
             artists.append(ln)
         tip = None
         if mdir is not None:
-            tip = ax.scatter([arrow * mdir[0]], [arrow * mdir[1]], [arrow * mdir[2]], color="#111111",
-                             marker="o", s=16, zorder=3, depthshade=False)
-            ax.text(*(1.04 * arrow * mdir + 0.1 * lim * cam[1]), "m", color="#111111", zorder=3, ha="center",
-                    va="center", fontsize=11)
+            tip = ax.scatter(
+                [arrow * mdir[0]],
+                [arrow * mdir[1]],
+                [arrow * mdir[2]],
+                color="#111111",
+                marker="o",
+                s=16,
+                zorder=3,
+                depthshade=False,
+            )
+            ax.text(
+                *(1.04 * arrow * mdir + 0.1 * lim * cam[1]),
+                "m",
+                color="#111111",
+                zorder=3,
+                ha="center",
+                va="center",
+                fontsize=11,
+            )
         # names are text: no mathtext ($...$ in a body name is drawn as typed)
         fig.text(0.5, 0.965, plain_text(one.label + " — " + one.method), ha="center", va="center", fontsize=10)
         ttext = fig.text(0.5, 0.925, "", ha="center", va="center", fontsize=9, color="#444444")
@@ -882,8 +911,9 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
                     coll.set_edgecolor(fc * 0.55)
                     for (a, b, _, _), ln in zip(lines, artists):
                         P = a + pieces[:, None] * (b - a)
-                        hid = hidden_by_box(a + mid[:, None] * (b - a), Rk, half, one.axes, towards_viewer,
-                                            orthographic=True)
+                        hid = hidden_by_box(
+                            a + mid[:, None] * (b - a), Rk, half, one.axes, towards_viewer, orthographic=True
+                        )
                         # a point is kept when one of its two pieces is visible
                         keep = np.zeros(len(P), bool)
                         keep[:-1] |= ~hid
@@ -891,8 +921,11 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
                         Pn = np.where(keep[:, None], P, np.nan)
                         ln.set_data_3d(Pn[:, 0], Pn[:, 1], Pn[:, 2])
                     if tip is not None:
-                        tip.set_visible(not hidden_by_box((arrow * mdir)[None], Rk, half, one.axes,
-                                                          towards_viewer, orthographic=True)[0])
+                        tip.set_visible(
+                            not hidden_by_box(
+                                (arrow * mdir)[None], Rk, half, one.axes, towards_viewer, orthographic=True
+                            )[0]
+                        )
                     ttext.set_text(plain_text(f"t = {tf[k]:.2f} {one.time_unit}"))
                     writer.grab_frame()
     return out

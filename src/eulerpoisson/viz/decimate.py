@@ -121,8 +121,15 @@ class MinMaxEnvelope:
         used = np.flatnonzero(count)
         empty = ~(lo[used] <= hi[used])
         with np.errstate(invalid="ignore"):
-            return Piece(used, np.where(empty, np.nan, lo[used]), np.where(empty, np.nan, hi[used]), count[used], n,
-                         float(np.min(t)), float(np.max(t)))
+            return Piece(
+                used,
+                np.where(empty, np.nan, lo[used]),
+                np.where(empty, np.nan, hi[used]),
+                count[used],
+                n,
+                float(np.min(t)),
+                float(np.max(t)),
+            )
 
     def _starts(self, t) -> np.ndarray:
         """First sample of every column reached by increasing times ``t``: where :meth:`bins_of` changes.
@@ -176,7 +183,7 @@ class MinMaxEnvelope:
         if bad.any():  # a column with NaN samples: their extremes without them (NaN when all are NaN)
             with np.errstate(invalid="ignore"):
                 for c, j in zip(*np.nonzero(bad)):
-                    seg = cols[j][starts[c]:ends[c]]
+                    seg = cols[j][starts[c] : ends[c]]
                     lo[c, j] = np.fmin.reduce(seg)
                     hi[c, j] = np.fmax.reduce(seg)
         return Piece(bins, lo, hi, ends - starts, n, tmin, tmax)

@@ -240,8 +240,10 @@ def select_body(traj, index=0) -> _One:
                     f"index={index!r} is out of range for a batch of {nb} bodies (batch shape {bshape})"
                 )
             idx: tuple = np.unravel_index(int(index) % nb, bshape)
-        elif isinstance(index, tuple) and len(index) == len(bshape) and all(
-            isinstance(i, (int, np.integer)) and not isinstance(i, bool) for i in index
+        elif (
+            isinstance(index, tuple)
+            and len(index) == len(bshape)
+            and all(isinstance(i, (int, np.integer)) and not isinstance(i, bool) for i in index)
         ):
             if not all(-n <= int(i) < n for i, n in zip(index, bshape)):
                 raise InvalidInputError(f"index={index!r} is out of range for batch shape {bshape}")
@@ -270,9 +272,17 @@ def select_body(traj, index=0) -> _One:
     first = int(np.flatnonzero(order == 0)[0])
     name = body.name
     return _One(
-        t=t[order], q=q, omega=omega, inertia=np.array(inertia), moments=np.array(moments),
-        axes=np.array(axes), first=first, name=name, method=str(traj.method or "?"),
-        time_unit=_time_unit(traj), label=_body_label(name, moments),
+        t=t[order],
+        q=q,
+        omega=omega,
+        inertia=np.array(inertia),
+        moments=np.array(moments),
+        axes=np.array(axes),
+        first=first,
+        name=name,
+        method=str(traj.method or "?"),
+        time_unit=_time_unit(traj),
+        label=_body_label(name, moments),
     )
 
 
@@ -406,8 +416,16 @@ def _ends(traj, index) -> _One:
     if _is_lazy(traj):
         ends = traj[[0, T - 1]]
     else:  # (indexing would build an index array of the run's length)
-        ends = Trajectory(traj.t[[0, T - 1]], traj.quaternion[..., [0, T - 1], :], traj.omega[..., [0, T - 1], :],
-                          traj.body, traj.method, traj.options, traj.stats, torque=list(traj.model.torques))
+        ends = Trajectory(
+            traj.t[[0, T - 1]],
+            traj.quaternion[..., [0, T - 1], :],
+            traj.omega[..., [0, T - 1], :],
+            traj.body,
+            traj.method,
+            traj.options,
+            traj.stats,
+            torque=list(traj.model.torques),
+        )
     one = select_body(ends, index)
     if not _is_lazy(traj):  # in memory: the true time range (the times may be in any order)
         one.t = np.array([float(np.min(traj.t)), float(np.max(traj.t))])
@@ -426,6 +444,7 @@ def _map_pieces(traj, idx, fn, names=("time", "quaternion", "omega"), size: int 
 
     size = _PIECE if size is None else size
     if _is_lazy(traj):
+
         def one(piece):
             return fn({k: (v if k == "time" or not idx else v[idx]) for k, v in piece.items()})
 
@@ -434,7 +453,7 @@ def _map_pieces(traj, idx, fn, names=("time", "quaternion", "omega"), size: int 
     q, w = traj.quaternion[idx], traj.omega[idx]
 
     def view(a):  # in memory: views, and the state only
-        return fn({"time": traj.t[a:a + size], "quaternion": q[a:a + size], "omega": w[a:a + size]})
+        return fn({"time": traj.t[a : a + size], "quaternion": q[a : a + size], "omega": w[a : a + size]})
 
     yield from ordered_map(view, range(0, len(traj.t), size))
 
@@ -489,8 +508,16 @@ def _thin(traj, limit: int, *, blocks: bool = False):
         T = len(traj.t)
         if T > limit:
             step = -(-T // limit)
-            traj = Trajectory(traj.t[::step], traj.quaternion[..., ::step, :], traj.omega[..., ::step, :],
-                              traj.body, traj.method, traj.options, traj.stats, torque=list(traj.model.torques))
+            traj = Trajectory(
+                traj.t[::step],
+                traj.quaternion[..., ::step, :],
+                traj.omega[..., ::step, :],
+                traj.body,
+                traj.method,
+                traj.options,
+                traj.stats,
+                torque=list(traj.model.torques),
+            )
         return (traj, [0]) if blocks else traj
     T = len(traj)
     chunks = traj.chunk_bounds()
@@ -518,16 +545,30 @@ def _thin(traj, limit: int, *, blocks: bool = False):
     parts = list(traj.map_arrays(("time", "quaternion", "omega"), ranges=ranges))  # read in parallel threads
     if not parts:
         return (traj.load(), [0]) if blocks else traj.load()
-    out = Trajectory(np.concatenate([p["time"] for p in parts]),
-                     np.concatenate([p["quaternion"] for p in parts], axis=-2),
-                     np.concatenate([p["omega"] for p in parts], axis=-2), traj.body, traj.method, traj.options,
-                     traj.stats, torque=list(traj.model.torques))
+    out = Trajectory(
+        np.concatenate([p["time"] for p in parts]),
+        np.concatenate([p["quaternion"] for p in parts], axis=-2),
+        np.concatenate([p["omega"] for p in parts], axis=-2),
+        traj.body,
+        traj.method,
+        traj.options,
+        traj.stats,
+        torque=list(traj.model.torques),
+    )
     return (out, starts) if blocks else out
 
 
 def _decimated_note(ax, n: int) -> None:
-    ax.text(0.005, 0.005, f"{n:,} samples: min/max per pixel column", transform=ax.transAxes, ha="left",
-            va="bottom", fontsize=7, color="0.45")
+    ax.text(
+        0.005,
+        0.005,
+        f"{n:,} samples: min/max per pixel column",
+        transform=ax.transAxes,
+        ha="left",
+        va="bottom",
+        fontsize=7,
+        color="0.45",
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -621,10 +662,20 @@ def _drift_values(traj, index):
     """
     from ..trajectory import Trajectory
 
-    first = traj[0] if _is_lazy(traj) else Trajectory(traj.t[:1], traj.quaternion[..., :1, :], traj.omega[..., :1, :],
-                                                      traj.body)
-    ref = select_body(Trajectory(np.array([0.0, 1.0]), np.repeat(first.quaternion, 2, axis=-2),
-                                 np.repeat(first.omega, 2, axis=-2), first.body), index)
+    first = (
+        traj[0]
+        if _is_lazy(traj)
+        else Trajectory(traj.t[:1], traj.quaternion[..., :1, :], traj.omega[..., :1, :], traj.body)
+    )
+    ref = select_body(
+        Trajectory(
+            np.array([0.0, 1.0]),
+            np.repeat(first.quaternion, 2, axis=-2),
+            np.repeat(first.omega, 2, axis=-2),
+            first.body,
+        ),
+        index,
+    )
     E0 = float(ref.energy[0])
     m0 = ref.m[0]
     mn0 = float(np.linalg.norm(m0))
@@ -660,8 +711,13 @@ def _drift_values(traj, index):
         mn += np.square(m2, out=sq)
         mn += np.square(m3, out=sq)
         np.sqrt(mn, out=mn)  # (a reduction over a short last axis is slow)
-        return [dist(E, E0, cols[0]), dist(mn, mn0, mn), dist(m1, m0[0], cols[2]), dist(m2, m0[1], cols[3]),
-                dist(m3, m0[2], cols[4])]
+        return [
+            dist(E, E0, cols[0]),
+            dist(mn, mn0, mn),
+            dist(m1, m0[0], cols[2]),
+            dist(m2, m0[1], cols[3]),
+            dist(m3, m0[2], cols[4]),
+        ]
 
     scales = np.array([abs(E0), mn0, mn0, mn0, mn0])
     return values, names, np.where(scales > 0, scales, 1.0)
@@ -740,8 +796,17 @@ def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
         if long:
             _decimated_note(ax, env.samples)
         ax.axhline(eps, color="0.5", lw=0.8, ls=":")
-        ax.annotate("machine ε", (1.0, eps), xycoords=("axes fraction", "data"), xytext=(-4, -3),
-                    textcoords="offset points", ha="right", va="top", fontsize=8, color="0.4")
+        ax.annotate(
+            "machine ε",
+            (1.0, eps),
+            xycoords=("axes fraction", "data"),
+            xytext=(-4, -3),
+            textcoords="offset points",
+            ha="right",
+            va="top",
+            fontsize=8,
+            color="0.4",
+        )
         top = max(float(np.nanmax([np.nanmax(y) for y in curves.values()])), 1e3 * eps)
         ax.set_ylim(eps / 4, top * 60)  # room for the legend above the curves
         ax.set_xlim(one.t[0], one.t[-1])
@@ -900,27 +965,34 @@ def plot_polhode(traj, ax=None, fig=None, *, index=0, family=4, **style):
             fam = int(family)
             first_family = True
             if not spherical and fam > 0:
-                fr = (np.arange(1, fam + 1) / (fam + 1))
+                fr = np.arange(1, fam + 1) / (fam + 1)
                 for D in np.concatenate([lo + fr * (mid - lo), mid + fr * (hi - mid)]):
                     if np.isclose(D, mid):
                         continue
                     for cur in sphere_conic(I, D, L, n=300):
-                        ax.plot(*cur.T, color="#8fa8c8", lw=0.6, alpha=0.8,
-                                label="other polhodes" if first_family else None)
+                        ax.plot(
+                            *cur.T, color="#8fa8c8", lw=0.6, alpha=0.8, label="other polhodes" if first_family else None
+                        )
                         first_family = False
             if not spherical:
                 for ic, cur in enumerate(sphere_conic(I, mid, L, n=600)):
                     ax.plot(*cur.T, color="k", lw=1.1, label="separatrices" if ic == 0 else None)
             D0 = 2.0 * float(one.energy[k]) / L**2
             for ic, cur in enumerate(sphere_conic(I, D0, L, n=600)):
-                ax.plot(*cur.T, color="#ff7f0e", lw=1.2, ls="--",
-                        label="|M| = L ∩ energy ellipsoid" if ic == 0 else None)
+                ax.plot(
+                    *cur.T, color="#ff7f0e", lw=1.2, ls="--", label="|M| = L ∩ energy ellipsoid" if ic == 0 else None
+                )
         # principal axes
         for i in range(3):
             e = np.eye(3)[i] * lim
             ax.plot(*np.stack([-e, e]).T, color=AXIS_COLORS[i], lw=0.9, alpha=0.9)
-            ax.text(*(1.08 * e), f"I{str(i + 1).translate(_SUB)}={_fmt(I[i])}",
-                    color=AXIS_COLORS[i], fontsize=8.5, ha="center")
+            ax.text(
+                *(1.08 * e),
+                f"I{str(i + 1).translate(_SUB)}={_fmt(I[i])}",
+                color=AXIS_COLORS[i],
+                fontsize=8.5,
+                ha="center",
+            )
         sl = _stride(len(Mp))
         kw = {"color": "#8c1d8c", "lw": 2.2, **style}
         ax.plot(*Mp[sl].T, label="M(t) computed", **kw)
@@ -1132,22 +1204,39 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
         kw = {"lw": 1.5, **style}
         ends = [n[-1] for _, n, _ in segs]
         # a long run has thousands of charts: draw at most MAX_CHARTS of them, evenly chosen in time
-        drawn = range(len(segs)) if len(segs) <= MAX_CHARTS else np.unique(
-            np.round(np.linspace(0, len(segs) - 1, MAX_CHARTS)).astype(int))
+        drawn = (
+            range(len(segs))
+            if len(segs) <= MAX_CHARTS
+            else np.unique(np.round(np.linspace(0, len(segs) - 1, MAX_CHARTS)).astype(int))
+        )
         for j in drawn:
             idx, n, _ = segs[j]
             sl = _stride(len(idx), 4000)
             pts = np.concatenate([n[sl], n[-1:]]) if len(n) > 1 else n
             ax.plot(*pts.T, color=cmap(norm(one.t[idx[0]])), **kw)
         if len(segs) > MAX_CHARTS:
-            ax.text2D(0.99, 0.01, f"{len(drawn)} of {len(segs)} charts drawn", transform=ax.transAxes, ha="right",
-                      va="bottom", fontsize=7.5, color="0.4")
+            ax.text2D(
+                0.99,
+                0.01,
+                f"{len(drawn)} of {len(segs)} charts drawn",
+                transform=ax.transAxes,
+                ha="right",
+                va="bottom",
+                fontsize=7.5,
+                color="0.4",
+            )
         ax.scatter([0], [0], [0], color="k", s=18, depthshade=False, label="chart centre n = 0")
         if len(segs) > 1:
             # the restarts that end the drawn charts (all of them when every chart is drawn)
             E = np.array([ends[j] for j in drawn if j < len(segs) - 1])
-            ax.scatter(*E.T, marker="x", color="#d62728", s=30 if len(segs) <= MAX_CHARTS else 12, depthshade=False,
-                       label=f"chart restart ({len(segs) - 1}×)")
+            ax.scatter(
+                *E.T,
+                marker="x",
+                color="#d62728",
+                s=30 if len(segs) <= MAX_CHARTS else 12,
+                depthshade=False,
+                label=f"chart restart ({len(segs) - 1}×)",
+            )
         for i in range(3):
             e = np.eye(3)[i] * lim
             ax.plot(*np.stack([-e, e]).T, color=AXIS_COLORS[i], lw=0.7, alpha=0.6)
@@ -1155,8 +1244,7 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
         cb = fig.colorbar(sm, ax=ax, shrink=0.6, pad=0.08)
         cb.set_label(f"chart start time [{one.unit}]")
         ax.legend(loc="upper left", fontsize=8)
-        ax.set_title(_title(
-            one, f"Gibbs vector n(t) = k tan(α/2) in local charts (restart at |n| = {_fmt(r)})"))
+        ax.set_title(_title(one, f"Gibbs vector n(t) = k tan(α/2) in local charts (restart at |n| = {_fmt(r)})"))
     return fig
 
 
@@ -1203,8 +1291,12 @@ def plot_attitude(traj, ax=None, fig=None, *, index=0, **style):
         _unit_sphere(ax, 1.0, alpha=0.15)
         kw = {"lw": 1.2, **style}
         for i in range(3):
-            ax.plot(*A[:, i].T, color=AXIS_COLORS[i],
-                    label=f"axis {i + 1} (I{str(i + 1).translate(_SUB)} = {_fmt(one.moments[i])})", **kw)
+            ax.plot(
+                *A[:, i].T,
+                color=AXIS_COLORS[i],
+                label=f"axis {i + 1} (I{str(i + 1).translate(_SUB)} = {_fmt(one.moments[i])})",
+                **kw,
+            )
             ax.scatter(*A[0, i], color=AXIS_COLORS[i], marker="o", s=22, depthshade=False)
             ax.scatter(*A[-1, i], color=AXIS_COLORS[i], marker="s", s=22, depthshade=False)
         if mn > 0:
@@ -1349,11 +1441,23 @@ def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **
             r = np.sin(np.radians(deg))
             if r > 1.3 * lim:
                 break
-            ax.plot(r * np.cos(ang), r * np.sin(ang), color="0.55" if deg == 90 else "0.8",
-                    lw=1.0 if deg == 90 else 0.6, zorder=1)
+            ax.plot(
+                r * np.cos(ang),
+                r * np.sin(ang),
+                color="0.55" if deg == 90 else "0.8",
+                lw=1.0 if deg == 90 else 0.6,
+                zorder=1,
+            )
             if deg % 30 == 0:
-                ax.annotate(f"{deg}°", (r * np.cos(np.pi / 4), r * np.sin(np.pi / 4)), color="0.45", fontsize=7.5,
-                            ha="left", va="bottom", zorder=1)
+                ax.annotate(
+                    f"{deg}°",
+                    (r * np.cos(np.pi / 4), r * np.sin(np.pi / 4)),
+                    color="0.45",
+                    fontsize=7.5,
+                    ha="left",
+                    va="bottom",
+                    zorder=1,
+                )
         pts = np.stack([x, y], -1)
         segs: Any = np.stack([pts[:-1], pts[1:]], 1)  # (N, 2, 2): LineCollection takes it (its stubs say a list)
         below = (h[:-1] < 0) & (h[1:] < 0)
@@ -1372,8 +1476,16 @@ def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **
         ax.set_xlabel("horizontal component 1 [dimensionless]")
         ax.set_ylabel("horizontal component 2 [dimensionless]")
         ax.legend(loc="lower left", fontsize=8)
-        ax.text(0.99, 0.01, f"polar angle {np.min(theta):.1f}° to {np.max(theta):.1f}°", transform=ax.transAxes,
-                ha="right", va="bottom", fontsize=8, color="0.3")
+        ax.text(
+            0.99,
+            0.01,
+            f"polar angle {np.min(theta):.1f}° to {np.max(theta):.1f}°",
+            transform=ax.transAxes,
+            ha="right",
+            va="bottom",
+            fontsize=8,
+            color="0.3",
+        )
         ax.grid(False)
         ax.set_title(_title(one, f"Axis R(t)·e on the unit sphere seen from above, {what}"))
     return fig
@@ -1419,8 +1531,15 @@ def save_figure(fig, out, *, dpi=None) -> Path:
     return p
 
 
-
-def plot(traj: Trajectory | LazyTrajectory, kind: str, out: str | os.PathLike[str] | None = None, *, index: int | tuple[int, ...] = 0, dpi: float | None = None, **kwargs: Any) -> Figure:
+def plot(
+    traj: Trajectory | LazyTrajectory,
+    kind: str,
+    out: str | os.PathLike[str] | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    dpi: float | None = None,
+    **kwargs: Any,
+) -> Figure:
     """Draw one kind of picture, and save it when ``out`` is given.
 
     Parameters

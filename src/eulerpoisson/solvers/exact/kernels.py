@@ -711,9 +711,30 @@ def _sncndn3(k, u1h, u1l, u2h, u2l, u3h, u3l, cst):
     if three:
         a3, b3, e3, f3, g3_, h3, i3, j3 = _finish(n3, r3, ng3, v3, s3, c3, sep, m, m1, kp)
     return (
-        a1, b1, e1, f1, g1_, h1, i1, j1,
-        a2, b2, e2, f2, g2_, h2, i2, j2,
-        a3, b3, e3, f3, g3_, h3, i3, j3,
+        a1,
+        b1,
+        e1,
+        f1,
+        g1_,
+        h1,
+        i1,
+        j1,
+        a2,
+        b2,
+        e2,
+        f2,
+        g2_,
+        h2,
+        i2,
+        j2,
+        a3,
+        b3,
+        e3,
+        f3,
+        g3_,
+        h3,
+        i3,
+        j3,
     )
 
 
@@ -776,8 +797,21 @@ def _get_jc(cst):
             cst[_C_JC] = 0.0
         else:
             rj, _, _ = _rj3(
-                0.0, cst[_C_M1], 1.0, cst[_C_OMNU], True,
-                0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False,
+                0.0,
+                cst[_C_M1],
+                1.0,
+                cst[_C_OMNU],
+                True,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                False,
+                0.0,
+                0.0,
+                0.0,
+                0.0,
+                False,
             )
             cst[_C_JC] = rj / 3.0
         cst[_C_HAVE_JC] = 1.0
@@ -790,8 +824,21 @@ def _get_jcd(cst):
         return _get_jc(cst)
     if cst[_C_HAVE_JCD] == 0.0:
         rj, _, _ = _rj3(
-            0.0, cst[_C_M1], 1.0, cst[_C_OMNUD], True,
-            0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False,
+            0.0,
+            cst[_C_M1],
+            1.0,
+            cst[_C_OMNUD],
+            True,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            False,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            False,
         )
         cst[_C_JCD] = rj / 3.0
         cst[_C_HAVE_JCD] = 1.0
@@ -887,9 +934,21 @@ def _far(cst, n, r, s, c, d):
     neff0 = n0 - 1.0 if caseB else n0
     odd0, S0, S20, C20, D20, p0 = _jtot_args(nu, omnu, neff0, cst[k + 2], cst[k + 3], cst[k + 4], kp)
     rjt, rj0, rjc = _rj3(
-        C2, D2, 1.0, p, S2 > 0.0,
-        C20, D20, 1.0, p0, do0 and S20 > 0.0,
-        0.0, m1, 1.0, omnu, doc,
+        C2,
+        D2,
+        1.0,
+        p,
+        S2 > 0.0,
+        C20,
+        D20,
+        1.0,
+        p0,
+        do0 and S20 > 0.0,
+        0.0,
+        m1,
+        1.0,
+        omnu,
+        doc,
     )
     if doc:
         cst[_C_JC] = rjc / 3.0
@@ -1137,7 +1196,8 @@ def _setup_pre(i0, i1, i2, m0, m1_, m2, cst):
     cst[_C_MSCALE] = _pow2(eM)
     cst[_C_TSCALE] = _pow2(eM - eI)
     eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _pre_regime(
-        M1, M2, M3, I1, I2, I3)
+        M1, M2, M3, I1, I2, I3
+    )
     if eq:
         cst[_C_REGIME] = _EQUILIBRIUM
         return True, 0.5, 0.5, 1.0, 1.0, False, 1.0, 0.0, 0.0, 0.0, 0.0
@@ -1244,9 +1304,30 @@ def body_eval(cst, t):
             k = 2 if near else 1
             u2h, u2l, u3h, u3l = dh, dl, 0.0, 0.0
         (
-            sn, cn, dn, n, r, s, c, d,
-            a2, b2, e2, f2, g2, h2, i2, j2,
-            a3, b3, e3, f3, g3, h3, i3, j3,
+            sn,
+            cn,
+            dn,
+            n,
+            r,
+            s,
+            c,
+            d,
+            a2,
+            b2,
+            e2,
+            f2,
+            g2,
+            h2,
+            i2,
+            j2,
+            a3,
+            b3,
+            e3,
+            f3,
+            g3,
+            h3,
+            i3,
+            j3,
         ) = _sncndn3(k, th, tl, u2h, u2l, u3h, u3l, cst)
         if first:
             # values at t = 0: sn(tau0), theta(tau0) and the reduced tau0
@@ -1384,9 +1465,7 @@ def constants_kernel(inertia, M0, out):
     nb = inertia.shape[0]
     cst = np.zeros(N_CONST)
     for b in range(nb):
-        if body_setup(
-            inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], cst
-        ):
+        if body_setup(inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], cst):
             out[b, 0] = _EQUILIBRIUM
             out[b, 1] = 0.0
             out[b, 2] = 1.0
@@ -1538,6 +1617,7 @@ if USE_NUMBA:  # pragma: no branch
     _far = _jit(_far)
     _qmin = _jiti(_qmin)
     _qmul = _jiti(_qmul)
+
     def _dv(a, b):  # noqa: F811 - compiled: the IEEE division (error_model="numpy")
         return a / b
 

@@ -206,8 +206,9 @@ def _validate(A, C, mass, ell, g, q0, omega0, t):
             f"{qn[np.abs(qn - 1.0) > _UNIT_TOL].ravel()[0]!r}"
         )
     try:
-        shape = np.broadcast_shapes(A.shape, C.shape, mass.shape, ell.shape, g.shape[:-1], q0.shape[:-1],
-                                    omega0.shape[:-1])
+        shape = np.broadcast_shapes(
+            A.shape, C.shape, mass.shape, ell.shape, g.shape[:-1], q0.shape[:-1], omega0.shape[:-1]
+        )
     except ValueError as exc:
         raise InvalidInputError(
             "the shapes of A, C, mass, ell, g[..., :], q0[..., :], omega0[..., :] do not broadcast: "
@@ -526,8 +527,29 @@ def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None, compil
     n1D = W2s / (W2s + d)
     PicD = _pi_complete(nD, n1D, K, m1)
     cD_per = np.where(zero2, 0.0, kap_d / ((W2s + d) * nu))
-    cst = dict(m1=m1, K=K, sd=sd, d=d, nu=nu, W1=W1, W2=W2, s1=s1, s2=s2, zero1=zero1, zero2=zero2, lam=lam,
-               kap_s=kap_s, kap_d=kap_d, nS=nS, n1S=n1S, PicS=PicS, direct=direct, nD=nD, n1D=n1D, PicD=PicD)
+    cst = dict(
+        m1=m1,
+        K=K,
+        sd=sd,
+        d=d,
+        nu=nu,
+        W1=W1,
+        W2=W2,
+        s1=s1,
+        s2=s2,
+        zero1=zero1,
+        zero2=zero2,
+        lam=lam,
+        kap_s=kap_s,
+        kap_d=kap_d,
+        nS=nS,
+        n1S=n1S,
+        PicS=PicS,
+        direct=direct,
+        nD=nD,
+        n1D=n1D,
+        PicD=PicD,
+    )
 
     # ---------------- initial phases e^{i sigma0}, e^{i delta0} ------------
     cc0, ss0, cdot0, sdot0, rate_c0, rate_s0, perS0, perD0 = _per_time(cst, tau0[:, None])
@@ -550,16 +572,43 @@ def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None, compil
         from . import lagrange_kernels as _LK
 
         Cb = np.empty((len(i), _LK.N_LAG))
-        for col, val in ((_LK._L_M1, m1), (_LK._L_M, 1.0 - m1), (_LK._L_K, K), (_LK._L_NU, nu),
-                         (_LK._L_TAU0, tau0), (_LK._L_SD, sd), (_LK._L_D, d), (_LK._L_W1, W1), (_LK._L_W2, W2),
-                         (_LK._L_S1, s1), (_LK._L_S2, s2), (_LK._L_Z1, zero1), (_LK._L_Z2, zero2),
-                         (_LK._L_LAM, lam), (_LK._L_KAPS, kap_s), (_LK._L_KAPD, kap_d), (_LK._L_NS, nS),
-                         (_LK._L_N1S, n1S), (_LK._L_PICS, PicS), (_LK._L_SHS, ~direct), (_LK._L_ND, nD),
-                         (_LK._L_N1D, n1D), (_LK._L_PICD, PicD), (_LK._L_CSLIN, cS_lin), (_LK._L_CSPER, cS_per),
-                         (_LK._L_CDPER, cD_per), (_LK._L_PERS0, perS0[:, 0]), (_LK._L_PERD0, perD0[:, 0]),
-                         (_LK._L_E1R, e1.real), (_LK._L_E1I, e1.imag), (_LK._L_E2R, e2.real),
-                         (_LK._L_E2I, e2.imag), (_LK._L_SDNU, sd * nu), (_LK._L_DNU, d * nu),
-                         (_LK._L_W, t_scale[i])):
+        for col, val in (
+            (_LK._L_M1, m1),
+            (_LK._L_M, 1.0 - m1),
+            (_LK._L_K, K),
+            (_LK._L_NU, nu),
+            (_LK._L_TAU0, tau0),
+            (_LK._L_SD, sd),
+            (_LK._L_D, d),
+            (_LK._L_W1, W1),
+            (_LK._L_W2, W2),
+            (_LK._L_S1, s1),
+            (_LK._L_S2, s2),
+            (_LK._L_Z1, zero1),
+            (_LK._L_Z2, zero2),
+            (_LK._L_LAM, lam),
+            (_LK._L_KAPS, kap_s),
+            (_LK._L_KAPD, kap_d),
+            (_LK._L_NS, nS),
+            (_LK._L_N1S, n1S),
+            (_LK._L_PICS, PicS),
+            (_LK._L_SHS, ~direct),
+            (_LK._L_ND, nD),
+            (_LK._L_N1D, n1D),
+            (_LK._L_PICD, PicD),
+            (_LK._L_CSLIN, cS_lin),
+            (_LK._L_CSPER, cS_per),
+            (_LK._L_CDPER, cD_per),
+            (_LK._L_PERS0, perS0[:, 0]),
+            (_LK._L_PERD0, perD0[:, 0]),
+            (_LK._L_E1R, e1.real),
+            (_LK._L_E1I, e1.imag),
+            (_LK._L_E2R, e2.real),
+            (_LK._L_E2I, e2.imag),
+            (_LK._L_SDNU, sd * nu),
+            (_LK._L_DNU, d * nu),
+            (_LK._L_W, t_scale[i]),
+        ):
             Cb[:, col] = val
         every = len(i) == N  # no steady body: the kernel writes the outputs themselves
         q = q_out if every else np.empty((len(i), T, 4))
@@ -744,9 +793,18 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
         q0f = q0f / np.linalg.norm(q0f, axis=-1, keepdims=True)
         kw, ks = kW[i], kS[i]
         W = np.ldexp(1.0, kw.astype(int))
-        q, o, final = _heavy_top(np.ldexp(A_[i], -ks.astype(int)), np.ldexp(C_[i], -ks.astype(int)),
-                                 np.ldexp(P[i], (-ks - 2 * kw).astype(int)), q0f, om_[i] / W[:, None],
-                                 W[:, None] * t[None, :], W, t, (qf, q0_in[i], om_[i]), compiled)
+        q, o, final = _heavy_top(
+            np.ldexp(A_[i], -ks.astype(int)),
+            np.ldexp(C_[i], -ks.astype(int)),
+            np.ldexp(P[i], (-ks - 2 * kw).astype(int)),
+            q0f,
+            om_[i] / W[:, None],
+            W[:, None] * t[None, :],
+            W,
+            t,
+            (qf, q0_in[i], om_[i]),
+            compiled,
+        )
         done = np.zeros(Nb, dtype=bool)
         # the compiled kernel did the last steps below for the bodies marked final
         done[i[final]] = True

@@ -209,9 +209,30 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
             tr = tau - 2.0 * jj * Ks
             k = 3 if shS else 2
             (
-                sn, cn, dn, _a, _b, _c, _d, _e,
-                snD, cnD, dnD, _f, _g, _h, _i, _j,
-                snS, cnS, dnS, _k, _l, _m, _n, _o,
+                sn,
+                cn,
+                dn,
+                _a,
+                _b,
+                _c,
+                _d,
+                _e,
+                snD,
+                cnD,
+                dnD,
+                _f,
+                _g,
+                _h,
+                _i,
+                _j,
+                snS,
+                cnS,
+                dnS,
+                _k,
+                _l,
+                _m,
+                _n,
+                _o,
             ) = _K._sncndn3(k, tau, 0.0, tr, 0.0, abs(tr), 0.0, cst)
             if not shS:
                 snS, cnS, dnS = snD, cnD, dnD
@@ -238,8 +259,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
             sS, s2S, c2S, d2S, pS = _reduced_args(nS, n1S, shS, snS, cnS, dnS, m1)
             sD, s2D, c2D, d2D, pD = _reduced_args(nD, n1D, False, snD, cnD, dnD, m1)
             rfS, rfD = _rf2(c2S, d2S, 1.0, c2D, d2D, 1.0)
-            rjS, rjD, _r = _K._rj3(c2S, d2S, 1.0, pS, True, c2D, d2D, 1.0, pD, True,
-                                   0.0, 0.0, 0.0, 0.0, False)
+            rjS, rjD, _r = _K._rj3(c2S, d2S, 1.0, pS, True, c2D, d2D, 1.0, pD, True, 0.0, 0.0, 0.0, 0.0, False)
             perS = _periodic(nS, sS, s2S, rfS, rjS, tr, jj, finite, picS, shS)
             perD = _periodic(nD, sD, s2D, rfD, rjD, tr, jj, finite, picD, False)
             dsig = cslin * ts + csper * (perS - perS0)

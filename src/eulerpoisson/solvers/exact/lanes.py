@@ -293,7 +293,9 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
     LC = stack_buffer(_JAC_LC)  # lane constants: sep, kh, kl, ph, pcorr, m, m1, kp, nlev
     LV = stack_buffer(_JAC_LV)  # Landen levels: sqrt(p_i) at i * LANES, 1 - p_i at (MAX_LANDEN + i) * LANES
     IN = stack_buffer(_JAC_IN)  # uh, ul, on of the slots
-    W = stack_buffer(_JAC_W)  # n, r, neg, vn, dv, im, s, c, y, v of the slots (im: 1 imaginary path, 0 real, 2 separatrix, -1 off)
+    W = stack_buffer(
+        _JAC_W
+    )  # n, r, neg, vn, dv, im, s, c, y, v of the slots (im: 1 imaginary path, 0 real, 2 separatrix, -1 off)
     OL = stack_buffer(_NJAC8)
     maxlev = 0
     for l in range(nl):
@@ -316,15 +318,18 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         for l in range(nl):
             j = o + l
             sep = LC[l] != 0.0
-            n, r, neg, v, vn, dv = _K._reduce(IN[j], IN[_NJAC + j], sep, LC[_L + l], LC[2 * _L + l],
-                                              LC[3 * _L + l], LC[4 * _L + l])
+            n, r, neg, v, vn, dv = _K._reduce(
+                IN[j], IN[_NJAC + j], sep, LC[_L + l], LC[2 * _L + l], LC[3 * _L + l], LC[4 * _L + l]
+            )
             W[j] = n
             W[_NJAC + j] = r
             W[2 * _NJAC + j] = 1.0 if neg else 0.0
             W[3 * _NJAC + j] = vn
             W[4 * _NJAC + j] = dv
             W[9 * _NJAC + j] = v
-            W[5 * _NJAC + j] = -1.0 if IN[2 * _NJAC + j] == 0.0 else (2.0 if sep else (1.0 if LC[5 * _L + l] > 0.5 else 0.0))
+            W[5 * _NJAC + j] = (
+                -1.0 if IN[2 * _NJAC + j] == 0.0 else (2.0 if sep else (1.0 if LC[5 * _L + l] > 0.5 else 0.0))
+            )
     any_real = False
     any_imag = False
     for g in range(ng):
@@ -408,8 +413,9 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
             cv = 1.0 / C0 if im else (C0 if sp else (1.0 - Y0 if Y0 < 0.5 else C0))
             dn_ = _K._dn(sv, cv, LC[5 * _L + l], LC[6 * _L + l])
             dv = cv if sp else dn_
-            a, b, e, f, h, kk, u, w = _K._quadrant(W[j], W[_NJAC + j], W[2 * _NJAC + j] != 0.0, sv, cv, dv,
-                                                   LC[7 * _L + l])
+            a, b, e, f, h, kk, u, w = _K._quadrant(
+                W[j], W[_NJAC + j], W[2 * _NJAC + j] != 0.0, sv, cv, dv, LC[7 * _L + l]
+            )
             OL[j] = a
             OL[_NJAC + j] = b
             OL[2 * _NJAC + j] = e
@@ -465,11 +471,11 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
     ALPHA = stack_buffer(_L)
     CA = stack_buffer(_L)
     SAL = stack_buffer(_L)
-    lam_r = CL[_C_LAM * _L:(_C_LAM + 1) * _L]
-    tsc_r = CL[_C_TSCALE * _L:(_C_TSCALE + 1) * _L]
-    t0h_r = CL[_C_T0H * _L:(_C_T0H + 1) * _L]
-    t0l_r = CL[_C_T0L * _L:(_C_T0L + 1) * _L]
-    kfull_r = CL[_C_KFULL * _L:(_C_KFULL + 1) * _L]
+    lam_r = CL[_C_LAM * _L : (_C_LAM + 1) * _L]
+    tsc_r = CL[_C_TSCALE * _L : (_C_TSCALE + 1) * _L]
+    t0h_r = CL[_C_T0H * _L : (_C_T0H + 1) * _L]
+    t0l_r = CL[_C_T0L * _L : (_C_T0L + 1) * _L]
+    kfull_r = CL[_C_KFULL * _L : (_C_KFULL + 1) * _L]
     # --- arguments: tau = lambda t + tau0 (double-double), near/far, first evaluation
     for l in range(nl):
         TS[l] = TT[l] * tsc_r[l]
@@ -542,12 +548,12 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         kp = CL[_C_KP * _L + l]
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
-        odd, S, S2, C2, D2, p = _K._jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l],
-                                              O[7 * _NJAC + l], kp)
+        odd, S, S2, C2, D2, p = _K._jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l], O[7 * _NJAC + l], kp)
         n0 = CL[_C_TAU0V * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        odd0, S0, S20, C20, D20, p0 = _K._jtot_args(nu, omnu, neff0, CL[(_C_TAU0V + 2) * _L + l],
-                                                    CL[(_C_TAU0V + 3) * _L + l], CL[(_C_TAU0V + 4) * _L + l], kp)
+        odd0, S0, S20, C20, D20, p0 = _K._jtot_args(
+            nu, omnu, neff0, CL[(_C_TAU0V + 2) * _L + l], CL[(_C_TAU0V + 3) * _L + l], CL[(_C_TAU0V + 4) * _L + l], kp
+        )
         AUX[l] = 1.0 if odd else 0.0
         AUX[_L + l] = S
         AUX[2 * _L + l] = S2
@@ -609,8 +615,9 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         jc = CL[_C_JC * _L + l]
         n0 = CL[_C_TAU0V * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        j0 = _K._jtot_from(AUX[6 * _L + l] != 0.0, neff0, CL[(_C_TAU0V + 1) * _L + l], jc, AUX[7 * _L + l],
-                           AUX[8 * _L + l], R0[l])
+        j0 = _K._jtot_from(
+            AUX[6 * _L + l] != 0.0, neff0, CL[(_C_TAU0V + 1) * _L + l], jc, AUX[7 * _L + l], AUX[8 * _L + l], R0[l]
+        )
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
         jj = _K._jtot_from(AUX[l] != 0.0, neff, O[4 * _NJAC + l], jc, AUX[_L + l], AUX[2 * _L + l], RT[l])
@@ -633,8 +640,9 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 continue
             j = int(GN[l])
             N = CL[_C_NADD * _L + l]
-            XADD[l] = _K._near_xadd(N, CL[_C_CADD * _L + l], O[l] * CL[_C_SN0 * _L + l], O[j], O[_NJAC + j],
-                                    O[2 * _NJAC + j])
+            XADD[l] = _K._near_xadd(
+                N, CL[_C_CADD * _L + l], O[l] * CL[_C_SN0 * _L + l], O[j], O[_NJAC + j], O[2 * _NJAC + j]
+            )
             dlt = DH[l] + DLo[l]
             caseB = CL[_C_CASEB * _L + l] != 0.0
             g0 = CL[_C_G0 * _L + l]
@@ -650,8 +658,9 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 nu = CL[_C_NUD * _L + l]
                 omnu = CL[_C_OMNUD * _L + l]
                 nx = n
-            odd, S, S2, C2, D2, p = _K._jtot_args(nu, omnu, nx, O[5 * _NJAC + j], O[6 * _NJAC + j],
-                                                  O[7 * _NJAC + j], CL[_C_KP * _L + l])
+            odd, S, S2, C2, D2, p = _K._jtot_args(
+                nu, omnu, nx, O[5 * _NJAC + j], O[6 * _NJAC + j], O[7 * _NJAC + j], CL[_C_KP * _L + l]
+            )
             AUX[l] = 1.0 if odd else 0.0
             AUX[_L + l] = S
             AUX[2 * _L + l] = S2
@@ -708,10 +717,10 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             else:
                 DJ[l] = jd + XADD[l]
     # --- attitude (kernels.body_eval)
-    caseb_r = CL[_C_CASEB * _L:(_C_CASEB + 1) * _L]
-    rate_r = CL[_C_RATE * _L:(_C_RATE + 1) * _L]
-    coef_r = CL[_C_COEF * _L:(_C_COEF + 1) * _L]
-    th0_r = CL[_C_THETA0 * _L:(_C_THETA0 + 1) * _L]
+    caseb_r = CL[_C_CASEB * _L : (_C_CASEB + 1) * _L]
+    rate_r = CL[_C_RATE * _L : (_C_RATE + 1) * _L]
+    coef_r = CL[_C_COEF * _L : (_C_COEF + 1) * _L]
+    th0_r = CL[_C_THETA0 * _L : (_C_THETA0 + 1) * _L]
     for l in range(nl):
         caseB = caseb_r[l] != 0.0
         psi = rate_r[l] * TS[l] + coef_r[l] * DJ[l]
@@ -940,8 +949,8 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
             Z[l] = 0.25 * (z + lam) if ron else z
             RFON[l] = 1.0 if ron else 0.0
         if it < _MAX_LANDEN:
-            sq_r = CL[(_C_SQM + it) * _L:(_C_SQM + it + 1) * _L]
-            pcl_r = CL[(_C_PCL + it) * _L:(_C_PCL + it + 1) * _L]
+            sq_r = CL[(_C_SQM + it) * _L : (_C_SQM + it + 1) * _L]
+            pcl_r = CL[(_C_PCL + it) * _L : (_C_PCL + it + 1) * _L]
             for l in range(nl):
                 # descending Landen chain (level it: nlev == it while the chain runs)
                 pc = PC[l]
@@ -979,7 +988,7 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
         PPL[l] = 0.0
     for i in range(maxlev):
         fi = 1.0 * i
-        sq_r = CL[(_C_SQM + i) * _L:(_C_SQM + i + 1) * _L]
+        sq_r = CL[(_C_SQM + i) * _L : (_C_SQM + i + 1) * _L]
         for l in range(nl):
             ok = fi < NLEV[l]
             oh, ol = _K._two_sum(1.0, sq_r[l])
@@ -1041,8 +1050,9 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
         M1 = M1u * fM
         M2 = M2u * fM
         M3 = M3u * fM
-        eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = (
-            _K._pre_regime(M1, M2, M3, I1u * fI, I2u * fI, I3u * fI))
+        eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _K._pre_regime(
+            M1, M2, M3, I1u * fI, I2u * fI, I3u * fI
+        )
         scalar = eq | ((mmax != 0.0) & (not okM)) | (not okI) | (fM == 0.0) | (fI == 0.0)
         PRE[l] = 1.0 if scalar else 0.0
         PRE[_L + l] = p0
@@ -1143,7 +1153,8 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
             # relative equilibria, scale factors that are not normal numbers: the scalar code
             b = b0 + l
             eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = _K._setup_pre(
-                inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], CL[l::_L])
+                inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], CL[l::_L]
+            )
             EQ[l] = 1.0 if eq else 0.0
             PM[l] = m
             PM1[l] = m1
@@ -1169,8 +1180,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
             _K._setup_post(CL[l::_L], PRF[l], PC0[l], PS0[l], PMa[l], PMb[l], PMc[l])
         else:
             # a relative equilibrium is evaluated by the caller; its lane computes along with neutral values
-            for k in (_C_AC, _C_A2, _C_AA, _C_SA, _C_SC, _C_Q0W, _C_MSCALE, _C_TSCALE, _C_LAM, _C_KFULL, _C_M,
-                      _C_M1):
+            for k in (_C_AC, _C_A2, _C_AA, _C_SA, _C_SC, _C_Q0W, _C_MSCALE, _C_TSCALE, _C_LAM, _C_KFULL, _C_M, _C_M1):
                 CL[k * _L + l] = 1.0
             for k in (_C_Q0X, _C_Q0Y, _C_Q0Z, _C_CASEB, _C_SEP, _C_T0H, _C_T0L, _C_RATE, _C_COEF, _C_THETA0):
                 CL[k * _L + l] = 0.0
@@ -1240,7 +1250,8 @@ def motion_lanes(inertia, M0, t, Mout, qout):
                     if EQ[l] != 0.0:
                         b = b0 + l
                         r0, r1, r2, r3, r4, r5, r6 = _K.equilibrium_eval(
-                            inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], t[j])
+                            inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], t[j]
+                        )
                         Mout[b, j, 0] = r0
                         Mout[b, j, 1] = r1
                         Mout[b, j, 2] = r2

@@ -143,8 +143,10 @@ class Exact(Method):
     def supports(cls, model) -> str | None:
         if model.is_free or _lagrange_parameters(model) is not None:
             return None
-        return ("the closed form covers the free body and the Lagrange top (a symmetric body with its centre of mass "
-                f"on the symmetry axis under one Gravity torque), and the model has {model.describe()}")
+        return (
+            "the closed form covers the free body and the Lagrange top (a symmetric body with its centre of mass "
+            f"on the symmetry axis under one Gravity torque), and the model has {model.describe()}"
+        )
 
     #: compiled kernels or NumPy, chosen for a whole batch by :meth:`for_batch` (None: from the problem run)
     _compiled: bool | None = None
@@ -207,8 +209,11 @@ class Exact(Method):
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
             q_rel = qmul(qmul(qP, q_rel), qPc)
         q = compose_initial(problem, q_rel)
-        return MethodResult(q=q, omega=omega, stats={"evaluations": int(np.prod(q.shape[:-1])),
-                                                     "compiled": bool(compiled and _numba_in_use())})
+        return MethodResult(
+            q=q,
+            omega=omega,
+            stats={"evaluations": int(np.prod(q.shape[:-1])), "compiled": bool(compiled and _numba_in_use())},
+        )
 
     def work_estimate(self, problem: Problem) -> float:
         """Seconds on one core (decides whether threads pay off): the measured costs of the lane kernel.
@@ -226,10 +231,13 @@ class Exact(Method):
         from .lagrange import lagrange_top_motion
 
         bshape = problem.batch_shape
-        A, C, mass, ell, g, F = (np.broadcast_to(x, bshape + x.shape[len(problem.model.batch_shape):])
-                                 for x in _lagrange_parameters(problem.model))
+        A, C, mass, ell, g, F = (
+            np.broadcast_to(x, bshape + x.shape[len(problem.model.batch_shape) :])
+            for x in _lagrange_parameters(problem.model)
+        )
         rate = np.sqrt(np.sum(problem.omega0 * problem.omega0, axis=-1)) + np.sqrt(
-            mass * np.sqrt(np.sum(g * g, axis=-1)) * np.abs(ell) / A)
+            mass * np.sqrt(np.sum(g * g, axis=-1)) * np.abs(ell) / A
+        )
         _check_phase_range(problem, rate)
         compiled = self._use_compiled(problem)
         if np.all(F.reshape(-1, 9) == np.eye(3).reshape(9)):
@@ -242,8 +250,15 @@ class Exact(Method):
             q, w = lagrange_top_motion(A, C, mass, ell, g, q0, w0, problem.t, compiled=compiled)
             q = qmul(q, (qF * np.array([1.0, -1.0, -1.0, -1.0]))[..., None, :])
             w = np.einsum("...ij,...tj->...ti", F, w)
-        return MethodResult(q=q, omega=w, stats={"evaluations": int(np.prod(q.shape[:-1])), "model": "lagrange top",
-                                                 "compiled": bool(compiled and _numba_in_use())})
+        return MethodResult(
+            q=q,
+            omega=w,
+            stats={
+                "evaluations": int(np.prod(q.shape[:-1])),
+                "model": "lagrange top",
+                "compiled": bool(compiled and _numba_in_use()),
+            },
+        )
 
 
 def _numba_in_use() -> bool:

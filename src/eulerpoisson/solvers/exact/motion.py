@@ -242,9 +242,7 @@ def _validate(inertia, M0):
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(f"M0 must be a real array of shape (..., 3), got {M0!r}") from exc
     if inertia.ndim < 1 or inertia.shape[-1] != 3:
-        raise InvalidInertiaError(
-            f"inertia must have shape (..., 3) (principal moments), got shape {inertia.shape}"
-        )
+        raise InvalidInertiaError(f"inertia must have shape (..., 3) (principal moments), got shape {inertia.shape}")
     if M0.ndim < 1 or M0.shape[-1] != 3:
         raise InvalidInputError(f"M0 must have shape (..., 3), got shape {M0.shape}")
     if not np.all(np.isfinite(inertia)):
@@ -261,8 +259,7 @@ def _validate(inertia, M0):
         batch = np.broadcast_shapes(inertia.shape[:-1], M0.shape[:-1])
     except ValueError as exc:
         raise InvalidInputError(
-            f"inertia batch shape {inertia.shape[:-1]} and M0 batch shape "
-            f"{M0.shape[:-1]} do not broadcast"
+            f"inertia batch shape {inertia.shape[:-1]} and M0 batch shape {M0.shape[:-1]} do not broadcast"
         ) from exc
     inertia = np.broadcast_to(inertia, batch + (3,)).reshape(-1, 3)
     M0 = np.broadcast_to(M0, batch + (3,)).reshape(-1, 3)
@@ -289,11 +286,7 @@ def _sorting(inertia):
     """
     perm = np.argsort(inertia, axis=-1, kind="stable")
     # parity of the permutation: number of inversions
-    inv = (
-        (perm[:, 0] > perm[:, 1]).astype(int)
-        + (perm[:, 0] > perm[:, 2])
-        + (perm[:, 1] > perm[:, 2])
-    )
+    inv = (perm[:, 0] > perm[:, 1]).astype(int) + (perm[:, 0] > perm[:, 2]) + (perm[:, 1] > perm[:, 2])
     sgn = np.ones(perm.shape)
     sgn[:, 1] = np.where(inv % 2 == 1, -1.0, 1.0)
     return perm, sgn
@@ -316,9 +309,37 @@ class _Body:
     """
 
     __slots__ = (
-        "regime", "m", "m1", "lam", "t0h", "t0l", "Ac", "A2", "Aa", "sa", "sc",
-        "rate", "coef", "nu", "omnu", "Jc", "Nadd", "Cadd", "nud", "omnud", "Jcd",
-        "g0", "Gc", "sn0", "sep", "caseB", "Jfar0", "theta0", "kfull", "P", "q0",
+        "regime",
+        "m",
+        "m1",
+        "lam",
+        "t0h",
+        "t0l",
+        "Ac",
+        "A2",
+        "Aa",
+        "sa",
+        "sc",
+        "rate",
+        "coef",
+        "nu",
+        "omnu",
+        "Jc",
+        "Nadd",
+        "Cadd",
+        "nud",
+        "omnud",
+        "Jcd",
+        "g0",
+        "Gc",
+        "sn0",
+        "sep",
+        "caseB",
+        "Jfar0",
+        "theta0",
+        "kfull",
+        "P",
+        "q0",
     )
     regime: np.ndarray
     m: np.ndarray
@@ -388,12 +409,7 @@ def _constants(Is, Ms):
     t1h, t1l = _dd_square_times(M1, d21h, d21l, I3)
     dh, _ = dd_add(t3h, t3l, -t1h, -t1l)
     D = dh / (I1 * I3)
-    eq = (
-        (msq == 0.0)
-        | (a1 == 0.0)
-        | (a3 == 0.0)
-        | ((dh == 0.0) & (M1 * M1 * d21 == 0.0) & (M3 * M3 * d32 == 0.0))
-    )
+    eq = (msq == 0.0) | (a1 == 0.0) | (a3 == 0.0) | ((dh == 0.0) & (M1 * M1 * d21 == 0.0) & (M3 * M3 * d32 == 0.0))
     g = ~eq
     I1, I2, I3, M1, M2, M3 = I1[g], I2[g], I3[g], M1[g], M2[g], M3[g]
     d21, d32, d31, msq, a1, a3, D = d21[g], d32[g], d31[g], msq[g], a1[g], a3[g], D[g]
@@ -419,9 +435,7 @@ def _constants(Is, Ms):
         A1 = np.sqrt(a3 * I1 / d31)
         A2 = np.where(caseB, np.sqrt(a3 * I2 / d32), np.sqrt(a1 * I2 / d21))
         A3 = np.sqrt(a1 * I3 / d31)
-        lam = np.where(
-            caseB, np.sqrt(d32 * a1 / (I1 * I2 * I3)), np.sqrt(d21 * a3 / (I1 * I2 * I3))
-        )
+        lam = np.where(caseB, np.sqrt(d32 * a1 / (I1 * I2 * I3)), np.sqrt(d21 * a3 / (I1 * I2 * I3)))
         # c-axis (cn) and a-axis (dn)
         Ac = np.where(caseB, A1, A3)
         Aa = np.where(caseB, A3, A1)
@@ -522,9 +536,7 @@ def _theta(B, P, n, s, c):
     """Unwrapped azimuth ``atan2(A2 sn tau, Ac cn tau) = n pi/2 + dtheta``
     (``n`` reduced modulo 8: only ``theta`` modulo ``4 pi`` is used)."""
     odd = np.mod(n, 2.0) == 1.0
-    dtheta = np.where(
-        odd, np.arctan2(B.Ac * P.kp * s, B.A2 * c), np.arctan2(B.A2 * s, B.Ac * c)
-    )
+    dtheta = np.where(odd, np.arctan2(B.Ac * P.kp * s, B.A2 * c), np.arctan2(B.A2 * s, B.Ac * c))
     return np.mod(n, 8.0) * (0.5 * np.pi) + dtheta
 
 
@@ -573,7 +585,12 @@ def _near(B, P, dh, dl, sn_tau):
         np.where(use_sh, B.omnu, B.omnud),
         np.where(use_sh, B.Jc, B.Jcd),
         np.where(use_sh, n - 1.0, n),
-        r, s, c, d, P.kp, B.sep,
+        r,
+        s,
+        c,
+        d,
+        P.kp,
+        B.sep,
     )
     if np.any(B.sep):
         jd = np.where(B.sep, _jsep(N, dlt), jd)
@@ -872,7 +889,7 @@ def _exact_motion_numpy(inertia, M0, t, chunk_size=_DEFAULT_CHUNK):
             bodies = gidx[sel]
             es = escale[bodies][:, None]
             for j0 in range(0, T, tb):
-                tt = t[j0:j0 + tb]
+                tt = t[j0 : j0 + tb]
                 ts = np.ldexp(tt[None, :], es)
                 (M1, M2, M3), q = _generic_block(Bb, ts)
                 Ms = np.stack(np.broadcast_arrays(M1, M2, M3), axis=-1)
@@ -891,9 +908,9 @@ def _exact_motion_numpy(inertia, M0, t, chunk_size=_DEFAULT_CHUNK):
                 np.put_along_axis(Mo, pb, sb * Ms, axis=-1)
                 vo = np.empty_like(qs[..., 1:])
                 np.put_along_axis(vo, pb, sb * qs[..., 1:], axis=-1)
-                Mout[bodies, j0:j0 + tb] = Mo
-                qout[bodies, j0:j0 + tb, 0] = qs[..., 0]
-                qout[bodies, j0:j0 + tb, 1:] = vo
+                Mout[bodies, j0 : j0 + tb] = Mo
+                qout[bodies, j0 : j0 + tb, 0] = qs[..., 0]
+                qout[bodies, j0 : j0 + tb, 1:] = vo
     return ExactMotion(Mout.reshape(batch + (T, 3)), qout.reshape(batch + (T, 4)))
 
 

@@ -133,8 +133,7 @@ class RKOptions(MethodOptions):
         integ = cfg["integrator"]
         if not isinstance(integ, str) or integ not in INTEGRATORS:
             raise InvalidInputError(
-                f"rk: unknown integrator {integ!r}; choose one of scipy's solve_ivp methods "
-                f"{', '.join(INTEGRATORS)}"
+                f"rk: unknown integrator {integ!r}; choose one of scipy's solve_ivp methods {', '.join(INTEGRATORS)}"
             )
         form = cfg["formulation"]
         if not isinstance(form, str) or form not in FORMULATIONS:
@@ -253,16 +252,23 @@ class RK(Method):
         moments = frame.moments
         qout = np.empty((4, B, T))
         wout = np.empty((3, B, T))
-        stats = {"integrator": cfg["integrator"], "formulation": cfg["formulation"], "nfev": 0, "njev": 0,
-                 "steps": 0, "chart_changes": 0}
+        stats = {
+            "integrator": cfg["integrator"],
+            "formulation": cfg["formulation"],
+            "nfev": 0,
+            "njev": 0,
+            "steps": 0,
+            "chart_changes": 0,
+        }
         t = problem.t
         if B:
             # an explicit Runge-Kutta step turns the body by at most a few radians (stability of
             # the oscillating solution): at least |Omega| |t| / (8 pi) steps, checked up front
             with np.errstate(over="ignore"):
                 wmax = float(np.max(np.sqrt(ch.dot(w0, w0))))
-            ch.check_step_budget("rk", t, wmax / (8.0 * math.pi), cfg["max_steps"],
-                                 "raise max_steps or shorten the times")
+            ch.check_step_budget(
+                "rk", t, wmax / (8.0 * math.pi), cfg["max_steps"], "raise max_steps or shorten the times"
+            )
         branches = [np.flatnonzero(t >= 0), np.flatnonzero(t < 0)]
         for b in range(B):
             stats["_nfev_body"] = 0  # max_steps is per body, both branches together
@@ -296,8 +302,16 @@ class RK(Method):
 
         with np.errstate(over="ignore", invalid="ignore"):
             try:
-                sol = solve_ivp(g, (t0, t1), y0, method=self.config["integrator"], rtol=rtol, atol=atol,
-                                dense_output=True, events=events)
+                sol = solve_ivp(
+                    g,
+                    (t0, t1),
+                    y0,
+                    method=self.config["integrator"],
+                    rtol=rtol,
+                    atol=atol,
+                    dense_output=True,
+                    events=events,
+                )
             except _StepBudgetExhausted:
                 raise EulerPoissonError(
                     f"rk: max_steps={max_steps} exhausted ({budget} evaluations of the right-hand side) before "
@@ -315,8 +329,10 @@ class RK(Method):
         if sol.status == -1:
             hint = ""
             if self.config["formulation"] == "gibbs":
-                hint = (f" (formulation='gibbs': |n| grows without bound near a half turn unless the chart is "
-                        f"changed; chart_threshold={self.config['chart_threshold']:g})")
+                hint = (
+                    f" (formulation='gibbs': |n| grows without bound near a half turn unless the chart is "
+                    f"changed; chart_threshold={self.config['chart_threshold']:g})"
+                )
             raise EulerPoissonError(f"rk: solve_ivp ({self.config['integrator']}) failed: {sol.message}{hint}")
         return sol
 
@@ -374,9 +390,9 @@ class RK(Method):
                 sol = self._call(make_rhs(qc), tcur, tend, y, rtol, atol, stats, events=event)
                 stop = float(sol.t[-1])
                 nrem = int(np.sum(np.abs(ts[k:]) <= abs(stop)))
-                ys = sol.sol(ts[k:k + nrem]) if nrem else np.empty((6, 0))
+                ys = sol.sol(ts[k : k + nrem]) if nrem else np.empty((6, 0))
             if nrem:
-                sel = order[k:k + nrem]
+                sel = order[k : k + nrem]
                 qq = ch.qmul(qc, ch.quaternion_from_gibbs(ys[:3]))
                 qo[:, sel] = qq / np.sqrt(ch.dot4(qq, qq))
                 wo[:, sel] = ys[3:]
@@ -405,8 +421,14 @@ class RK(Method):
         w0 = problem.omega0.reshape(B, 3)
         qout = np.empty((B, T, 4))
         wout = np.empty((B, T, 3))
-        stats = {"integrator": cfg["integrator"], "formulation": cfg["formulation"], "nfev": 0, "njev": 0,
-                 "steps": 0, "chart_changes": 0}
+        stats = {
+            "integrator": cfg["integrator"],
+            "formulation": cfg["formulation"],
+            "nfev": 0,
+            "njev": 0,
+            "steps": 0,
+            "chart_changes": 0,
+        }
         branches = [np.flatnonzero(t >= 0), np.flatnonzero(t < 0)]
         for b in range(B):
             model = problem.model.element(np.unravel_index(b, bshape) if bshape else ())

@@ -184,10 +184,24 @@ def run_exact_splitting(moments, qp0, Mp0, data, t, dt, order):
             ts = np.ascontiguousarray(t[oi])
             qo = np.empty((ts.shape[0], 4))
             Mo = np.empty((ts.shape[0], 3))
-            steps += split_body(np.ascontiguousarray(moments[b]), np.ascontiguousarray(qp0[b]),
-                                np.ascontiguousarray(Mp0[b]), data.tau0[b], np.ascontiguousarray(data.S[b]),
-                                np.ascontiguousarray(data.L[b]), float(data.nu[b]), float(data.kappa[b]), ts,
-                                float(dt), c, d, qo, Mo, cst, tau)
+            steps += split_body(
+                np.ascontiguousarray(moments[b]),
+                np.ascontiguousarray(qp0[b]),
+                np.ascontiguousarray(Mp0[b]),
+                data.tau0[b],
+                np.ascontiguousarray(data.S[b]),
+                np.ascontiguousarray(data.L[b]),
+                float(data.nu[b]),
+                float(data.kappa[b]),
+                ts,
+                float(dt),
+                c,
+                d,
+                qo,
+                Mo,
+                cst,
+                tau,
+            )
             qout[b, oi] = qo
             Mout[b, oi] = Mo
     return qout, Mout, steps

@@ -272,8 +272,13 @@ def schedule(t, dt):
             outs.append(i)
             rs.append(1 if first else 0)
             first = False
-    return (np.array(hs, dtype=np.float64), np.array(ns, dtype=np.int64), np.array(outs, dtype=np.int64),
-            np.array(rs, dtype=np.int64), total)
+    return (
+        np.array(hs, dtype=np.float64),
+        np.array(ns, dtype=np.int64),
+        np.array(outs, dtype=np.int64),
+        np.array(rs, dtype=np.int64),
+        total,
+    )
 
 
 # ---------------------------------------------------------------------------
@@ -409,10 +414,16 @@ def _nb_field(q0, q1, q2, q3, p0, p1, p2, p3, i0, i1, i2):
     a = i0 * (0.5 * (q0 * p1 - q1 * p0 - q2 * p3 + q3 * p2))
     b = i1 * (0.5 * (q0 * p2 + q1 * p3 - q2 * p0 - q3 * p1))
     c = i2 * (0.5 * (q0 * p3 - q1 * p2 + q2 * p1 - q3 * p0))
-    return (-0.5 * (q1 * a + q2 * b + q3 * c), 0.5 * (q0 * a + q2 * c - q3 * b),
-            0.5 * (q0 * b - q1 * c + q3 * a), 0.5 * (q0 * c + q1 * b - q2 * a),
-            -0.5 * (p1 * a + p2 * b + p3 * c), 0.5 * (p0 * a + p2 * c - p3 * b),
-            0.5 * (p0 * b - p1 * c + p3 * a), 0.5 * (p0 * c + p1 * b - p2 * a))
+    return (
+        -0.5 * (q1 * a + q2 * b + q3 * c),
+        0.5 * (q0 * a + q2 * c - q3 * b),
+        0.5 * (q0 * b - q1 * c + q3 * a),
+        0.5 * (q0 * c + q1 * b - q2 * a),
+        -0.5 * (p1 * a + p2 * b + p3 * c),
+        0.5 * (p0 * a + p2 * c - p3 * b),
+        0.5 * (p0 * b - p1 * c + p3 * a),
+        0.5 * (p0 * c + p1 * b - p2 * a),
+    )
 
 
 def _nb_gauss_fields(buf, b):
@@ -423,11 +434,19 @@ def _nb_gauss_fields(buf, b):
         z = _GZ + 8 * L * i
         for l in range(L):
             keep = buf[_GACT + l] == 0.0
-            f = _nb_field(buf[_GY + l] + buf[z + l], buf[_GY + L + l] + buf[z + L + l],
-                          buf[_GY + 2 * L + l] + buf[z + 2 * L + l], buf[_GY + 3 * L + l] + buf[z + 3 * L + l],
-                          buf[_GY + 4 * L + l] + buf[z + 4 * L + l], buf[_GY + 5 * L + l] + buf[z + 5 * L + l],
-                          buf[_GY + 6 * L + l] + buf[z + 6 * L + l], buf[_GY + 7 * L + l] + buf[z + 7 * L + l],
-                          buf[_GI + l], buf[_GI + L + l], buf[_GI + 2 * L + l])
+            f = _nb_field(
+                buf[_GY + l] + buf[z + l],
+                buf[_GY + L + l] + buf[z + L + l],
+                buf[_GY + 2 * L + l] + buf[z + 2 * L + l],
+                buf[_GY + 3 * L + l] + buf[z + 3 * L + l],
+                buf[_GY + 4 * L + l] + buf[z + 4 * L + l],
+                buf[_GY + 5 * L + l] + buf[z + 5 * L + l],
+                buf[_GY + 6 * L + l] + buf[z + 6 * L + l],
+                buf[_GY + 7 * L + l] + buf[z + 7 * L + l],
+                buf[_GI + l],
+                buf[_GI + L + l],
+                buf[_GI + 2 * L + l],
+            )
             for d in range(8):
                 r = _GF + (8 * i + d) * L + l
                 old = buf[r]
@@ -687,8 +706,19 @@ def run_splitting(q0, M0, inv_m, sequence, t, dt):
     fracs = np.array([f for _, f in sequence], dtype=np.float64)
     q_out = np.empty((B, T, 4))
     w_out = np.empty((B, T, 3))
-    _nb_splitting(np.ascontiguousarray(q0, dtype=np.float64), np.ascontiguousarray(M0, dtype=np.float64),
-                  np.ascontiguousarray(inv_m, dtype=np.float64), axes, fracs, h, n, out, restart, q_out, w_out)
+    _nb_splitting(
+        np.ascontiguousarray(q0, dtype=np.float64),
+        np.ascontiguousarray(M0, dtype=np.float64),
+        np.ascontiguousarray(inv_m, dtype=np.float64),
+        axes,
+        fracs,
+        h,
+        n,
+        out,
+        restart,
+        q_out,
+        w_out,
+    )
     return q_out, w_out, total
 
 
@@ -727,6 +757,20 @@ def run_gauss_quaternion(y0, inv_m, tableau, t, dt, max_iter):
     w_out = np.empty((B, T, 3))
     iters = np.zeros((B, 2), dtype=np.int64)
     status = np.zeros(4)
-    _nb_gauss(np.ascontiguousarray(y0, dtype=np.float64), np.ascontiguousarray(inv_m, dtype=np.float64),
-              A, b, E, int(max_iter), h, n, out, restart, q_out, w_out, iters, status)
+    _nb_gauss(
+        np.ascontiguousarray(y0, dtype=np.float64),
+        np.ascontiguousarray(inv_m, dtype=np.float64),
+        A,
+        b,
+        E,
+        int(max_iter),
+        h,
+        n,
+        out,
+        restart,
+        q_out,
+        w_out,
+        iters,
+        status,
+    )
     return q_out, w_out, iters, total, status

@@ -115,8 +115,15 @@ __all__ = ["Symplectic", "GaussTableau", "gauss_tableau", "gauss_step", "splitti
 _EPS = np.finfo(float).eps
 
 #: schemes and their orders
-SCHEMES = {"gauss2": 2, "gauss4": 4, "gauss6": 6, "splitting": 2, "splitting4": 4, "exact_splitting": 2,
-           "exact_splitting4": 4}
+SCHEMES = {
+    "gauss2": 2,
+    "gauss4": 4,
+    "gauss6": 6,
+    "splitting": 2,
+    "splitting4": 4,
+    "exact_splitting": 2,
+    "exact_splitting4": 4,
+}
 
 #: the schemes that run bodies under torque
 TORQUE_SCHEMES = ("exact_splitting", "exact_splitting4")
@@ -260,8 +267,18 @@ def _error_max_iter(max_iter, bad, h):
     )
 
 
-def gauss_step(y0, h, inv_moments, tableau: GaussTableau, *, max_iter: int = 100, iterations: int | None = None,
-               field=ch.canonical_field, Z0=None, counts=None):
+def gauss_step(
+    y0,
+    h,
+    inv_moments,
+    tableau: GaussTableau,
+    *,
+    max_iter: int = 100,
+    iterations: int | None = None,
+    field=ch.canonical_field,
+    Z0=None,
+    counts=None,
+):
     r"""One step of Gauss-Legendre collocation for :math:`(\mathbf n, \boldsymbol\pi)`, batched.
 
     Solves the stage equations :math:`Z_i = h\sum_j a_{ij}f(y_0+Z_j)` by
@@ -488,9 +505,7 @@ class SymplecticOptions(MethodOptions):
         cfg = self.to_dict()
         scheme = cfg["scheme"]
         if scheme is not None and (not isinstance(scheme, str) or scheme not in SCHEMES):
-            raise InvalidInputError(
-                f"symplectic: unknown scheme {scheme!r}; choose one of {', '.join(SCHEMES)}"
-            )
+            raise InvalidInputError(f"symplectic: unknown scheme {scheme!r}; choose one of {', '.join(SCHEMES)}")
         if cfg["variables"] not in VARIABLES:
             raise InvalidInputError(
                 f"symplectic: unknown variables {cfg['variables']!r}; choose one of {', '.join(VARIABLES)}"
@@ -660,8 +675,10 @@ class Symplectic(Method):
         if model.is_free:
             return None
         if any(t.depends_on_omega for t in model.torques) or model.polynomial() is None:
-            return ("its splitting kicks with torques that depend on the time and the attitude only (Gravity, "
-                    f"GravityGradient, BodyTorque, SpaceTorque), and the model has {model.describe()}")
+            return (
+                "its splitting kicks with torques that depend on the time and the attitude only (Gravity, "
+                f"GravityGradient, BodyTorque, SpaceTorque), and the model has {model.describe()}"
+            )
         return None
 
     # ------------------------------------------------------------------
@@ -686,8 +703,13 @@ class Symplectic(Method):
             dt = self._batch_dt if self._batch_dt is not None else self._free_default_dt(w0)
         dt = float(dt)
         if B:
-            ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
-                                 "raise max_steps or dt, or shorten the times")
+            ch.check_step_budget(
+                "symplectic",
+                problem.t,
+                1.0 / dt if dt > 0 else math.inf,
+                cfg["max_steps"],
+                "raise max_steps or dt, or shorten the times",
+            )
         stats = {"scheme": scheme, "dt": dt}
         compiled = _k.USE_NUMBA and B > 0 and (not scheme.startswith("gauss") or cfg["variables"] == "quaternion")
         stats["compiled"] = bool(compiled)
@@ -704,8 +726,9 @@ class Symplectic(Method):
             outs, nsteps = run(problem.t, dt, q0, w0, moments, inv_m, SCHEMES[scheme], stats)
         T = problem.t.shape[0]
         if compiled:  # outputs (B, T, C) -> (C, B, T); copied for the frame (einsum rounds by memory layout)
-            outs = tuple(np.moveaxis(o, -1, 0) if frame is None else np.ascontiguousarray(np.moveaxis(o, -1, 0))
-                         for o in outs)
+            outs = tuple(
+                np.moveaxis(o, -1, 0) if frame is None else np.ascontiguousarray(np.moveaxis(o, -1, 0)) for o in outs
+            )
         q, w = outs if frame is None else frame.from_principal(*outs)  # (4, B, T), (3, B, T)
         q = np.moveaxis(q, 0, -1).reshape(bshape + (T, 4))
         w = np.moveaxis(w, 0, -1).reshape(bshape + (T, 3))
@@ -767,8 +790,16 @@ class Symplectic(Method):
         def advance(y, h, nsteps):
             Z = None
             for _ in range(nsteps):
-                y, _, Z = gauss_step(y, h, inv_m, tab, max_iter=max_iter, field=ch.quaternion_field,
-                                     Z0=None if Z is None else _combine(E, Z), counts=counts)
+                y, _, Z = gauss_step(
+                    y,
+                    h,
+                    inv_m,
+                    tab,
+                    max_iter=max_iter,
+                    field=ch.quaternion_field,
+                    Z0=None if Z is None else _combine(E, Z),
+                    counts=counts,
+                )
                 total[:] += counts
                 np.maximum(most, counts, out=most)
             return y
@@ -844,8 +875,13 @@ class Symplectic(Method):
             dt = self._batch_dt if self._batch_dt is not None else self._torque_default_dt(problem)
         dt = float(dt)
         if B:
-            ch.check_step_budget("symplectic", problem.t, 1.0 / dt if dt > 0 else math.inf, cfg["max_steps"],
-                                 "raise max_steps or dt, or shorten the times")
+            ch.check_step_budget(
+                "symplectic",
+                problem.t,
+                1.0 / dt if dt > 0 else math.inf,
+                cfg["max_steps"],
+                "raise max_steps or dt, or shorten the times",
+            )
         qp, Mp, nsteps = run_exact_splitting(D, qp0, Mp0, data, problem.t, dt, order)
         if not (np.all(np.isfinite(qp)) and np.all(np.isfinite(Mp))):
             raise EulerPoissonError("symplectic: the state became non-finite (the step dt is far too large)")

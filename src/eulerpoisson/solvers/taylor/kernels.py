@@ -298,7 +298,7 @@ def series_canonical(inertia_inv, n0, pi0, order):
 # ---------------------------------------------------------------------------
 def _sqrt(x):
     if x.dtype == object:
-        return x ** 0.5
+        return x**0.5
     return np.sqrt(x)
 
 
@@ -814,7 +814,7 @@ def _nb_series_lanes(a, buf, order):
     acc = stack_buffer(_ACC)
     for k in range(order):
         ok = k * _TR
-        ck = buf[ok:ok + _TR]
+        ck = buf[ok : ok + _TR]
         for l in range(_TL):
             nx = buf[_CN + l]
             ny = buf[_CN + _TL + l]
@@ -835,8 +835,8 @@ def _nb_series_lanes(a, buf, order):
         for j in range(1, k + 1):
             oj = j * _TR
             om = (k - j) * _TR
-            cj = buf[oj:oj + _TR]
-            cm = buf[om:om + _TR]
+            cj = buf[oj : oj + _TR]
+            cm = buf[om : om + _TR]
             for l in range(_TL):
                 nx = cj[_CN + l]
                 ny = cj[_CN + _TL + l]
@@ -869,7 +869,7 @@ def _nb_series_lanes(a, buf, order):
             acc[5 * _TL + l] = a[_TL + l] * acc[5 * _TL + l] / e
             acc[6 * _TL + l] = a[2 * _TL + l] * acc[6 * _TL + l] / e
         o1 = ok + _TR
-        c1 = buf[o1:o1 + _TR]
+        c1 = buf[o1 : o1 + _TR]
         for l in range(_TL):
             ck[_CS + l] = acc[l]
             c1[_CN + l] = acc[7 * _TL + l]
@@ -897,12 +897,36 @@ def _nb_lane_horner_delta(buf, l, order, theta):
         b0 = b0 * theta + buf[o + 3 * _TL]
         b1 = b1 * theta + buf[o + 4 * _TL]
         b2 = b2 * theta + buf[o + 5 * _TL]
-    return (_nb_mul(a0, theta), _nb_mul(a1, theta), _nb_mul(a2, theta),
-            _nb_mul(b0, theta), _nb_mul(b1, theta), _nb_mul(b2, theta))
+    return (
+        _nb_mul(a0, theta),
+        _nb_mul(a1, theta),
+        _nb_mul(a2, theta),
+        _nb_mul(b0, theta),
+        _nb_mul(b1, theta),
+        _nb_mul(b2, theta),
+    )
 
 
-def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold,
-                        q_out, w_out, stats, buf, lane_a, lane_i, lane_f):
+def _nb_integrate_lanes(
+    moments,
+    w0,
+    qref0,
+    t,
+    idx_pos,
+    idx_neg,
+    tol,
+    order,
+    dt,
+    max_steps,
+    threshold,
+    q_out,
+    w_out,
+    stats,
+    buf,
+    lane_a,
+    lane_i,
+    lane_f,
+):
     """:func:`_nb_integrate` with ``_TL`` bodies in lockstep, one per lane.
 
     Every lane runs the scalar kernel's algorithm on its own body (its own
@@ -922,18 +946,18 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
     # int state per lane: body (-1 none), direction, output pointer, outputs of
     # the direction, steps, charts, status, needs a task, active, advanced
     body = lane_i[0:_TL]
-    dirn = lane_i[_TL:2 * _TL]
-    ptr = lane_i[2 * _TL:3 * _TL]
-    nout = lane_i[3 * _TL:4 * _TL]
-    steps = lane_i[4 * _TL:5 * _TL]
-    charts = lane_i[5 * _TL:6 * _TL]
-    status = lane_i[6 * _TL:7 * _TL]
-    need = lane_i[7 * _TL:8 * _TL]
-    active = lane_i[8 * _TL:9 * _TL]
-    adv = lane_i[9 * _TL:10 * _TL]
+    dirn = lane_i[_TL : 2 * _TL]
+    ptr = lane_i[2 * _TL : 3 * _TL]
+    nout = lane_i[3 * _TL : 4 * _TL]
+    steps = lane_i[4 * _TL : 5 * _TL]
+    charts = lane_i[5 * _TL : 6 * _TL]
+    status = lane_i[6 * _TL : 7 * _TL]
+    need = lane_i[7 * _TL : 8 * _TL]
+    active = lane_i[8 * _TL : 9 * _TL]
+    adv = lane_i[9 * _TL : 10 * _TL]
     scale_w = lane_f[0:_TL]
-    tlast = lane_f[_TL:2 * _TL]
-    sgn = lane_f[2 * _TL:3 * _TL]
+    tlast = lane_f[_TL : 2 * _TL]
+    sgn = lane_f[2 * _TL : 3 * _TL]
     for l in range(_TL):
         body[l] = -1
         need[l] = 1
@@ -1102,7 +1126,7 @@ def _nb_integrate_lanes(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt,
                 x[_XDW + c * _TL + l] = buf[oo + _CW + c * _TL + l]
         for k in range(order - 1, 0, -1):
             ok = k * _TR
-            ck = buf[ok:ok + _TR]
+            ck = buf[ok : ok + _TR]
             for l in range(_TL):
                 hl = x[_XH + l]
                 x[_XDN + l] = x[_XDN + l] * hl + ck[_CN + l]
@@ -1217,8 +1241,22 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     q_out = np.zeros((B, T, 4))
     w_out = np.zeros((B, T, 3))
     stats = np.zeros((B, 3), dtype=np.int64)
-    args = (moments, w0, qref0, t, pos, neg, float(tol), int(order), float(dt) if dt is not None else -1.0,
-            int(max_steps), float(threshold), q_out, w_out, stats)
+    args = (
+        moments,
+        w0,
+        qref0,
+        t,
+        pos,
+        neg,
+        float(tol),
+        int(order),
+        float(dt) if dt is not None else -1.0,
+        int(max_steps),
+        float(threshold),
+        q_out,
+        w_out,
+        stats,
+    )
     if lanes is None:
         lanes = USE_NUMBA and B >= LANES_MIN_BODIES
     if lanes:

@@ -136,7 +136,7 @@ def _as_array(x, name, tail=()):
             a = cand
     if a is not None and _is_generic(a):
         nt = len(tail)
-        if nt and (a.ndim < nt or a.shape[a.ndim - nt:] != tuple(tail)):
+        if nt and (a.ndim < nt or a.shape[a.ndim - nt :] != tuple(tail)):
             want = "(..., " + ", ".join(str(t) for t in tail) + ")"
             raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
         return a
@@ -313,7 +313,9 @@ def lie_series_coefficients(n0, pi0, inertia, order):
         Iinv = parts[2]
     shape = np.broadcast_shapes(n.shape[1:], p.shape[1:], Iinv.shape[2:])
     N, P = _k.series_canonical(
-        np.broadcast_to(Iinv, (3, 3) + shape), np.broadcast_to(n, (3,) + shape), np.broadcast_to(p, (3,) + shape),
+        np.broadcast_to(Iinv, (3, 3) + shape),
+        np.broadcast_to(n, (3,) + shape),
+        np.broadcast_to(p, (3,) + shape),
         order,
     )
     return np.moveaxis(N, 1, -1), np.moveaxis(P, 1, -1)
@@ -645,8 +647,10 @@ class Taylor(Method):
     def supports(cls, model) -> str | None:
         if model.is_free or model.polynomial() is not None:
             return None
-        return ("taylor expands polynomial torques (Gravity, GravityGradient, BodyTorque, SpaceTorque) in Taylor "
-                f"series, and the model has {model.describe()}, which is not one")
+        return (
+            "taylor expands polynomial torques (Gravity, GravityGradient, BodyTorque, SpaceTorque) in Taylor "
+            f"series, and the model has {model.describe()}, which is not one"
+        )
 
     def run(self, problem: Problem) -> MethodResult:
         if not problem.model.is_free:
@@ -668,8 +672,16 @@ class Taylor(Method):
             qP = quaternion_from_rotation_matrix(P)
             qref0 = qmul(q0, qP)
         q, om, stats = integrate_principal(
-            moments, w0p, problem.t, q0=qref0, tol=c["tol"], order=c["order"], dt=c["dt"],
-            max_steps=c["max_steps"], chart_threshold=c["chart_threshold"], lanes=self._lanes,
+            moments,
+            w0p,
+            problem.t,
+            q0=qref0,
+            tol=c["tol"],
+            order=c["order"],
+            dt=c["dt"],
+            max_steps=c["max_steps"],
+            chart_threshold=c["chart_threshold"],
+            lanes=self._lanes,
         )
         if not diagonal:
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
@@ -695,14 +707,24 @@ class Taylor(Method):
                 for i, v in np.ndenumerate(a):
                     out[i] = mpmath.mpf(v) if not isinstance(v, mpmath.mpf) else v
                 return out
+
         with ctx:
             m, w, q, Pg = conv(moments), conv(w0), conv(q0), conv(P)
             if not diagonal:
                 w = np.einsum("bji,bj->bi", Pg, w)
                 q = qmul(q, conv(quaternion_from_rotation_matrix(P)))
-            qo, om, stats = integrate_principal(m, w, conv(problem.t), q0=q, tol=c["tol"], order=c["order"],
-                                                dt=c["dt"], max_steps=c["max_steps"],
-                                                chart_threshold=c["chart_threshold"], backend="numpy")
+            qo, om, stats = integrate_principal(
+                m,
+                w,
+                conv(problem.t),
+                q0=q,
+                tol=c["tol"],
+                order=c["order"],
+                dt=c["dt"],
+                max_steps=c["max_steps"],
+                chart_threshold=c["chart_threshold"],
+                backend="numpy",
+            )
             if qo.ndim == 2:
                 qo, om = qo[None], om[None]
             if not diagonal:
@@ -722,19 +744,31 @@ class Taylor(Method):
 
         c = self.config
         if c["precision"] != "float64":
-            raise InvalidInputError(f"taylor: precision={c['precision']!r} is for the free body; under torque "
-                                    f"the integration runs in float64 (precision='float64')")
+            raise InvalidInputError(
+                f"taylor: precision={c['precision']!r} is for the free body; under torque "
+                f"the integration runs in float64 (precision='float64')"
+            )
         bshape = problem.batch_shape
         B = int(np.prod(bshape, dtype=int))
         poly = problem.model.polynomial()
         assert poly is not None  # supports() admits polynomial torques only
         data = poly.flatten(bshape)
         inertia = np.ascontiguousarray(problem.inertia.reshape(B, 3, 3))
-        order = c["order"] if c["order"] is not None else (DEFAULT_FIXED_ORDER if c["dt"] is not None
-                                                           else auto_order(float(c["tol"])))
+        order = (
+            c["order"]
+            if c["order"] is not None
+            else (DEFAULT_FIXED_ORDER if c["dt"] is not None else auto_order(float(c["tol"])))
+        )
         q, om, stats, status = integrate_polynomial(
-            inertia, problem.q0.reshape(B, 4), problem.omega0.reshape(B, 3), data, problem.t,
-            tol=float(c["tol"]), order=int(order), dt=c["dt"], max_steps=int(c["max_steps"]),
+            inertia,
+            problem.q0.reshape(B, 4),
+            problem.omega0.reshape(B, 3),
+            data,
+            problem.t,
+            tol=float(c["tol"]),
+            order=int(order),
+            dt=c["dt"],
+            max_steps=int(c["max_steps"]),
         )
         if np.any(status == 1):
             b = int(np.flatnonzero(status == 1)[0])

@@ -518,10 +518,22 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
             qo = np.empty((ts.shape[0], 4))
             wo = np.empty((ts.shape[0], 3))
             steps, st = integrate_body(
-                np.ascontiguousarray(q0[b]), np.ascontiguousarray(w0[b]), np.ascontiguousarray(inertia[b]),
-                np.ascontiguousarray(Iinv[b]), data.tau0[b], np.ascontiguousarray(data.S[b]),
-                np.ascontiguousarray(data.L[b]), float(data.nu[b]), float(data.kappa[b]), ts, float(tol), int(order),
-                fixed, int(max_steps - used), qo, wo,
+                np.ascontiguousarray(q0[b]),
+                np.ascontiguousarray(w0[b]),
+                np.ascontiguousarray(inertia[b]),
+                np.ascontiguousarray(Iinv[b]),
+                data.tau0[b],
+                np.ascontiguousarray(data.S[b]),
+                np.ascontiguousarray(data.L[b]),
+                float(data.nu[b]),
+                float(data.kappa[b]),
+                ts,
+                float(tol),
+                int(order),
+                fixed,
+                int(max_steps - used),
+                qo,
+                wo,
             )
             used += steps
             qout[b, order_idx] = qo
@@ -531,6 +543,11 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
                 break
         steps_total += used
         steps_max = max(steps_max, used)
-    stats = {"steps": steps_total, "steps_max": steps_max, "max_order": int(order), "backend": BACKEND,
-             "chart_changes": 0}
+    stats = {
+        "steps": steps_total,
+        "steps_max": steps_max,
+        "max_order": int(order),
+        "backend": BACKEND,
+        "chart_changes": 0,
+    }
     return qout, wout, stats, status

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import sys
 from pathlib import Path
@@ -28,6 +29,10 @@ extensions = [
     "sphinx_gallery.gen_gallery",
     "myst_parser",
 ]
+# MathJax copied into the site (the docs extra installs it), so the formulas render offline too; without
+# the package the pages load MathJax from its CDN
+if importlib.util.find_spec("sphinx-mathjax-offline") is not None:
+    extensions.append("sphinx-mathjax-offline")
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"

@@ -23,6 +23,7 @@ from .registry import (
     get_method,
     methods_supporting,
     register_method,
+    unregister_method,
 )
 from .rk.method import RKOptions
 from .symplectic.method import SymplecticOptions
@@ -42,6 +43,7 @@ __all__ = [
     "check_supported",
     "MethodResult",
     "register_method",
+    "unregister_method",
     "available_methods",
     "get_method",
     "solve",

@@ -24,6 +24,7 @@ __all__ = [
     "Method",
     "MethodResult",
     "register_method",
+    "unregister_method",
     "available_methods",
     "get_method",
     "methods_supporting",
@@ -287,13 +288,42 @@ def register_method(cls: type[Method]) -> type[Method]:
     >>> print(ep.solve([1.0, 2.0, 2.5], [0.0, 1.0], omega0=[1.0, 0.0, 0.0], method="still").omega)
     [[0. 0. 0.]
      [0. 0. 0.]]
-    >>> from eulerpoisson.solvers.registry import _REGISTRY
-    >>> _ = _REGISTRY.pop("still")                                   # the registry as it was
+    >>> from eulerpoisson.solvers import unregister_method
+    >>> unregister_method("still").__name__                          # the registry as it was
+    'Still'
     """
     if not cls.name:
         raise ValueError("a registered method needs a name")
     cls.options = cls.Options.defaults()
     _REGISTRY[cls.name] = cls
+    return cls
+
+
+def unregister_method(name: str) -> type[Method]:
+    """Remove the method registered under ``name`` (a plug-in's, or one registered for a test) and return it.
+
+    Raises
+    ------
+    InvalidInputError
+        ``name`` is not a registered method.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.solvers import register_method, unregister_method
+    >>> from eulerpoisson.solvers.exact import Exact
+    >>> @register_method
+    ... class Exact2(Exact):
+    ...     name = "exact2"
+    >>> "exact2" in ep.available_methods()
+    True
+    >>> unregister_method("exact2").__name__
+    'Exact2'
+    >>> "exact2" in ep.available_methods()
+    False
+    """
+    cls = get_method(name)
+    del _REGISTRY[name]
     return cls
 
 

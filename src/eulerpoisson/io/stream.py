@@ -315,7 +315,7 @@ class ProgressDisplay:
 # ---------------------------------------------------------------------------
 # work folder
 # ---------------------------------------------------------------------------
-def _work_dir(path: Path) -> Path:
+def work_dir(path: Path) -> Path:
     return path.with_name(f".{path.name}.partial")
 
 
@@ -323,7 +323,7 @@ def _finished_run(path: Path):
     """The arguments recorded in a finished store (None if there are none or it is not a store of ours)."""
     try:
         zarr = require("zarr", "dask")
-        with _quiet_zarr():
+        with quiet_zarr():
             g = zarr.open_group(str(path), mode="r")
             raw = g.attrs.get("eulerpoisson_run")
         return json.loads(raw) if isinstance(raw, str) else None
@@ -337,20 +337,20 @@ def partial_store(path: str | os.PathLike[str]) -> Path:
     Readable while the run is going on or after it was interrupted
     (``xarray.open_zarr(partial_store(path))``); unfinished samples read as NaN.
     """
-    return _work_dir(Path(path)) / "store.zarr"
+    return work_dir(Path(path)) / "store.zarr"
 
 
-def _write_json_atomic(path: Path, obj) -> None:
+def write_json_atomic(path: Path, obj) -> None:
     from .atomic import atomic_write_text
 
     atomic_write_text(path, json.dumps(obj, sort_keys=True, indent=1))
 
 
-def _mark_done(work: Path, k: int, info: dict) -> None:
-    _write_json_atomic(work / "done" / f"{k:09d}", info)
+def mark_done(work: Path, k: int, info: dict) -> None:
+    write_json_atomic(work / "done" / f"{k:09d}", info)
 
 
-def _done_chunks(work: Path) -> set[int]:
+def done_chunks(work: Path) -> set[int]:
     d = work / "done"
     if not d.is_dir():
         return set()
@@ -362,7 +362,7 @@ def _is_zarr_store(path: Path) -> bool:
     return any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zarray"))
 
 
-def _check_replaceable(dest: Path) -> None:
+def check_replaceable(dest: Path) -> None:
     """FileExistsError when ``dest`` is a folder that is not a Zarr store (``overwrite`` must not delete it)."""
     if dest.is_dir() and not dest.is_symlink() and not _is_zarr_store(dest):
         raise FileExistsError(
@@ -371,12 +371,12 @@ def _check_replaceable(dest: Path) -> None:
         )
 
 
-def _replace_dir(src: Path, dest: Path, overwrite: bool) -> None:
+def replace_dir(src: Path, dest: Path, overwrite: bool) -> None:
     """Move folder ``src`` to ``dest``; an existing ``dest`` is replaced only with ``overwrite``."""
     if dest.exists() or dest.is_symlink():
         if not overwrite:
             raise FileExistsError(f"{dest} exists; pass overwrite=True to replace it")
-        _check_replaceable(dest)
+        check_replaceable(dest)
         trash = dest.with_name(f".{dest.name}.old-{os.getpid()}")
         os.replace(dest, trash)
         os.replace(src, dest)
@@ -389,7 +389,7 @@ def _replace_dir(src: Path, dest: Path, overwrite: bool) -> None:
 
 
 @contextlib.contextmanager
-def _quiet_zarr():
+def quiet_zarr():
     """Silence zarr's warnings about v3 extensions (fixed-width strings, consolidated metadata)."""
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message=".*Zarr format 3 specification.*")
@@ -735,12 +735,12 @@ def solve_to_file(
         fingerprint["torque"] = torque_fingerprint(model)
 
     if overwrite:
-        _check_replaceable(path)  # before any work, not after
+        check_replaceable(path)  # before any work, not after
     if path.exists() and not overwrite:
         if resume and _finished_run(path) == fingerprint:
             return path  # the same run finished before: nothing to do
         raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    work = _work_dir(path)
+    work = work_dir(path)
     store = work / "store.zarr"
     done: set[int] = set()
     if work.exists():
@@ -763,7 +763,7 @@ def solve_to_file(
                 "pass overwrite=True to discard it"
             )
         else:
-            done = _done_chunks(work)
+            done = done_chunks(work)
 
     # metadata template: a one-sample trajectory at the initial state
     template = Trajectory(
@@ -778,7 +778,7 @@ def solve_to_file(
 
     if not work.exists():
         (work / "done").mkdir(parents=True)
-        with _quiet_zarr():
+        with quiet_zarr():
             g = zarr.open_group(str(store), mode="w")
             attrs = dict(template.attrs)
             attrs.update({"T": n, "stream_chunk": chunk, "stats": "{}"})
@@ -808,9 +808,9 @@ def solve_to_file(
                 if "time" not in dims:
                     arr[...] = v.values
             zarr.consolidate_metadata(str(store))  # the partial store reads like the final one
-        _write_json_atomic(work / "state.json", fingerprint)  # last: marks the store as complete and resumable
+        write_json_atomic(work / "state.json", fingerprint)  # last: marks the store as complete and resumable
 
-    with _quiet_zarr():
+    with quiet_zarr():
         g = zarr.open_group(str(store), mode="r+")
     arrays = {name: g[name] for name in variables}
     tarr = g["time"]
@@ -838,7 +838,7 @@ def solve_to_file(
                     prev_q = None
                     continue
                 if prev_q is None and a > 0:  # resumed after finished chunks: the state they end in
-                    with _quiet_zarr():
+                    with quiet_zarr():
                         prev_q = np.asarray(g["quaternion"][tslice(a - 1, a)]).reshape(bshape + (4,))
                         prev_w = np.asarray(g["omega"][tslice(a - 1, a)]).reshape(bshape + (3,))
                         prev_t = float(tarr[a - 1])
@@ -867,7 +867,7 @@ def solve_to_file(
                     tr.quaternion = q
                 data = _chunk_arrays(tr, variables)
                 wall = _time.perf_counter() - start
-                with _quiet_zarr():
+                with quiet_zarr():
                     for name, arr in arrays.items():
                         arr[tslice(a, b)] = _flatten_batch(data[name], bshape)
                     tarr[a:b] = tc
@@ -878,7 +878,7 @@ def solve_to_file(
                     and not isinstance(val, bool)
                     and key not in ("wall_time", "threads")
                 }
-                _mark_done(work, k, {"wall_time": wall, "stats": counters, "written": datetime.now(UTC).isoformat()})
+                mark_done(work, k, {"wall_time": wall, "stats": counters, "written": datetime.now(UTC).isoformat()})
                 prev_q = q[..., -1, :]
                 prev_w = tr.omega[..., -1, :]
                 prev_t = float(tc[-1])
@@ -902,7 +902,7 @@ def solve_to_file(
         totals["wall_time"] += float(info.get("wall_time", 0.0))
         for key, val in info.get("stats", {}).items():
             totals[key] = totals.get(key, 0) + val
-    with _quiet_zarr():
+    with quiet_zarr():
         g.attrs.update(
             {
                 "stats": json.dumps(totals, default=float, sort_keys=True),
@@ -913,7 +913,7 @@ def solve_to_file(
             }
         )
         zarr.consolidate_metadata(str(store))
-    _replace_dir(store, path, overwrite)
+    replace_dir(store, path, overwrite)
     shutil.rmtree(work, ignore_errors=True)
     return path
 

@@ -113,23 +113,28 @@ import numbers
 import os
 import shutil
 import time as _time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+from numpy.typing import ArrayLike
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 from ..errors import EulerPoissonError, InvalidInputError, require
 from ..io.stream import (
     ProgressDisplay,
-    _check_replaceable,
-    _done_chunks,
-    _mark_done,
-    _quiet_zarr,
-    _replace_dir,
-    _work_dir,
-    _write_json_atomic,
+    check_replaceable,
+    done_chunks,
+    mark_done,
+    quiet_zarr,
+    replace_dir,
+    work_dir,
+    write_json_atomic,
 )
 
 __all__ = [
@@ -333,7 +338,7 @@ def is_remote(scheduler: str) -> bool:
     return scheduler.startswith(("tcp://", "tls://"))
 
 
-def load_config(source) -> SweepConfig:
+def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
     """Read and validate a sweep description.
 
     Parameters
@@ -557,7 +562,15 @@ def _rotation_angle(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
     return 2.0 * np.arctan2(np.linalg.norm(v, axis=-1), np.abs(w))
 
 
-def compute_points(inertia, M0, *, T: float, delta: float = 1e-6, method: str = "exact", workers=None) -> dict:
+def compute_points(
+    inertia: ArrayLike,
+    M0: ArrayLike,
+    *,
+    T: float,
+    delta: float = 1e-6,
+    method: str = "exact",
+    workers: int | None = None,
+) -> dict[str, Any]:
     r"""Flip half-period, :math:`k^2`, attitude sensitivity and status of a batch of points.
 
     Parameters
@@ -809,13 +822,13 @@ def _local_cluster(workers):
 
 
 def run_sweep(
-    config,
+    config: SweepConfig | str | os.PathLike[str] | dict[str, Any],
     *,
-    path=None,
+    path: str | os.PathLike[str] | None = None,
     scheduler: str | None = None,
     workers: int | None = None,
-    client=None,
-    progress=None,
+    client: Any = None,
+    progress: bool | Callable[[int, int], object] | None = None,
     overwrite: bool = False,
 ) -> Path:
     """Run (or resume) a sweep and write its Zarr store.
@@ -912,11 +925,11 @@ def run_sweep(
     fp_text = json.dumps(fp, sort_keys=True)
 
     if overwrite:
-        _check_replaceable(path)  # before any work, not after
+        check_replaceable(path)  # before any work, not after
     if path.exists():
         if not overwrite:
             try:
-                with _quiet_zarr():
+                with quiet_zarr():
                     same = zarr.open_group(str(path), mode="r").attrs.get("sweep_config") == fp_text
             except Exception:  # not a zarr store
                 same = False
@@ -926,7 +939,7 @@ def run_sweep(
                 f"{path} exists and holds a different sweep (or no sweep); pass overwrite=True to replace it"
             )
 
-    work = _work_dir(path)
+    work = work_dir(path)
     store = work / "store.zarr"
     done: set[int] = set()
     if work.exists():
@@ -936,7 +949,7 @@ def run_sweep(
         except (OSError, ValueError):
             old = None  # interrupted while the store was being created: nothing was computed
         if old == fp:
-            done = _done_chunks(work)
+            done = done_chunks(work)
         elif old is None or overwrite:
             shutil.rmtree(work)
         else:
@@ -945,12 +958,12 @@ def run_sweep(
             )
     if not work.exists():
         (work / "done").mkdir(parents=True)
-        with _quiet_zarr():
+        with quiet_zarr():
             _create_store(zarr, store, cfg)
             zarr.consolidate_metadata(str(store))  # the partial store reads like the final one
-        _write_json_atomic(work / "state.json", fp)  # last: marks the store as complete and resumable
+        write_json_atomic(work / "state.json", fp)  # last: marks the store as complete and resumable
 
-    with _quiet_zarr():
+    with quiet_zarr():
         g = zarr.open_group(str(store), mode="r+")
         arrs = {
             name: g[name] for name in ("I1", "I2", "I3", "M0", *_RESULTS, "chunk_count", "chunk_seconds", "chunk_time")
@@ -964,20 +977,20 @@ def run_sweep(
 
     def inputs(k):
         a, b = bounds(k)
-        with _quiet_zarr():
+        with quiet_zarr():
             I = np.stack([np.asarray(arrs[name][a:b]) for name in ("I1", "I2", "I3")], -1)
             M = np.asarray(arrs["M0"][a:b])
         return I, M
 
     def write(k, res):
         a, b = bounds(k)
-        with _quiet_zarr():
+        with quiet_zarr():
             for name in _RESULTS:
                 arrs[name][a:b] = res[name]
             arrs["chunk_count"][k] = int(arrs["chunk_count"][k]) + 1
             arrs["chunk_seconds"][k] = float(res["seconds"])
             arrs["chunk_time"][k] = _time.time()
-        _mark_done(work, k, {"seconds": float(res["seconds"])})
+        mark_done(work, k, {"seconds": float(res["seconds"])})
 
     n_done = sum(bounds(k)[1] - bounds(k)[0] for k in done)
     args = (cfg.T, cfg.delta, cfg.method, n)
@@ -996,10 +1009,10 @@ def run_sweep(
         exc.add_note(f"eulerpoisson: the finished chunks of the sweep are kept in {store}; rerun the sweep to resume")
         raise
 
-    with _quiet_zarr():
+    with quiet_zarr():
         g.attrs["history"] = f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
         zarr.consolidate_metadata(str(store))
-    _replace_dir(store, path, overwrite)
+    replace_dir(store, path, overwrite)
     shutil.rmtree(work, ignore_errors=True)
     return path
 
@@ -1053,7 +1066,7 @@ def _run_distributed(client, scheduler, workers, todo, inputs, write, args, boun
 # ---------------------------------------------------------------------------
 # reading and plotting
 # ---------------------------------------------------------------------------
-def load_sweep(path, *, squeeze: bool = True):
+def load_sweep(path: str | os.PathLike[str], *, squeeze: bool = True) -> xr.Dataset:
     """Read a sweep store as an :class:`xarray.Dataset`.
 
     A grid sweep is reshaped to its axes (``I1, I2, I3`` or ``I1, ratio21,
@@ -1095,13 +1108,13 @@ def load_sweep(path, *, squeeze: bool = True):
     require("zarr", "dask")
     p = Path(path)
     if not p.exists():
-        work = _work_dir(p)
+        work = work_dir(p)
         hint = (
             f"; an unfinished sweep is in {work / 'store.zarr'} (rerun the sweep to finish it)" if work.exists() else ""
         )
         raise FileNotFoundError(f"no sweep store at {p}{hint}")
     try:
-        with _quiet_zarr():
+        with quiet_zarr():
             ds = xr.open_zarr(str(p), consolidated=None).load()
     except Exception as exc:
         raise EulerPoissonError(f"{p} is not a readable Zarr store: {exc}") from exc
@@ -1136,7 +1149,13 @@ def _middle_gap(I: np.ndarray, M: np.ndarray) -> np.ndarray:
     return np.sum(M**2 * (mid / I - 1.0), -1)
 
 
-def plot_atlas(ds, out, *, variables=("half_period", "sensitivity"), dpi: int = 150):
+def plot_atlas(
+    ds: xr.Dataset,
+    out: str | os.PathLike[str],
+    *,
+    variables: Sequence[str] = ("half_period", "sensitivity"),
+    dpi: int = 150,
+) -> Path:
     """Heat maps of a sweep: the flip half-period (and sensitivity) with the separatrix drawn.
 
     A grid sweep with two axes of length > 1 is drawn as a heat map over
@@ -1184,7 +1203,9 @@ def plot_atlas(ds, out, *, variables=("half_period", "sensitivity"), dpi: int = 
     variables = [variables] if isinstance(variables, str) else list(variables)
     for v in variables:
         if v not in ds.data_vars:
-            raise InvalidInputError(f"variables: {v!r} is not in the sweep; choose from {', '.join(ds.data_vars)}")
+            raise InvalidInputError(
+                f"variables: {v!r} is not in the sweep; choose from {', '.join(map(str, ds.data_vars))}"
+            )
     mpl = require("matplotlib", "plot")
     from matplotlib.colors import LogNorm
     from matplotlib.figure import Figure
@@ -1214,7 +1235,7 @@ def plot_atlas(ds, out, *, variables=("half_period", "sensitivity"), dpi: int = 
             ax.invert_yaxis()
             ax.set_title(names.get(v, v))
     else:
-        dims = [d for d in ds["half_period"].dims]
+        dims = [str(d) for d in ds["half_period"].dims]
         if len(dims) != 2:
             raise InvalidInputError(
                 f"plot_atlas draws a grid with exactly two axes of length > 1, this one has {dims}; "

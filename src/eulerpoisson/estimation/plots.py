@@ -5,9 +5,18 @@ matplotlib is imported inside the functions (the ``plot`` extra).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d import Axes3D
+
+    from .result import FitResult
 
 __all__ = ["plot_residuals", "plot_fit", "plot_polhode", "save_plots"]
 
@@ -35,7 +44,7 @@ def _kinds(result):
     return [k for k in ("attitude", "omega", "axis") if k in result.residuals]
 
 
-def plot_residuals(result, ax=None):
+def plot_residuals(result: FitResult, ax: Axes | None = None) -> Figure:
     """Residuals of each kind over time, divided by nothing (their units), with the sigma band."""
     plt = _plt()
     kinds = _kinds(result)
@@ -61,7 +70,7 @@ def plot_residuals(result, ax=None):
     return fig
 
 
-def plot_fit(result, samples: int = 800):
+def plot_fit(result: FitResult, samples: int = 800) -> Figure:
     """The fitted motion (lines, closed form) against the observations (dots): attitude quaternion and rate."""
     plt = _plt()
     obs = result.observations
@@ -112,7 +121,7 @@ def plot_fit(result, samples: int = 800):
     return fig
 
 
-def plot_polhode(result, ax=None, samples: int = 2000):
+def plot_polhode(result: FitResult, ax: Axes3D | None = None, samples: int = 2000) -> Figure:
     """The body angular momentum of the fitted motion over one period of the polhode, in the principal frame."""
     plt = _plt()
     from ..analysis import momentum_period
@@ -149,7 +158,7 @@ def plot_polhode(result, ax=None, samples: int = 2000):
     return fig
 
 
-def save_plots(result, directory) -> list[Path]:
+def save_plots(result: FitResult, directory: str | os.PathLike[str]) -> list[Path]:
     """Write the three figures as PNG files (atomically) into ``directory``; returns the paths."""
     from ..io.atomic import atomic_path
 

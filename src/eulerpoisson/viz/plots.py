@@ -106,7 +106,10 @@ from ..io.atomic import atomic_path
 from ..numerics.quaternion import qmul, qmul_components
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d import Axes3D
+    from numpy.typing import ArrayLike
 
     from ..io.read import LazyTrajectory
     from ..trajectory import Trajectory
@@ -574,7 +577,14 @@ def _decimated_note(ax, n: int) -> None:
 # ---------------------------------------------------------------------------
 # omega
 # ---------------------------------------------------------------------------
-def plot_omega(traj, ax=None, fig=None, *, index=0, **style):
+def plot_omega(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    **style: Any,
+) -> Figure:
     r"""Body angular velocity :math:`\boldsymbol\Omega(t)`, one curve per component.
 
     For a body near its intermediate axis (the tennis racket) the middle
@@ -746,7 +756,14 @@ def _rotate(q, v):
     return v + w * tt + np.cross(u, tt)
 
 
-def plot_invariants(traj, ax=None, fig=None, *, index=0, **style):
+def plot_invariants(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    **style: Any,
+) -> Figure:
     r"""Relative drift of the integrals of motion on a log scale.
 
     Curves :math:`|E(t)-E_0|/|E_0|`,
@@ -915,7 +932,15 @@ def sphere_conic(moments, level, radius, n=1200):
     return out
 
 
-def plot_polhode(traj, ax=None, fig=None, *, index=0, family=4, **style):
+def plot_polhode(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes3D | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    family: int = 4,
+    **style: Any,
+) -> Figure:
     r"""The body angular momentum on the momentum sphere (polhode picture).
 
     Draws, in the principal frame of the body: the computed path
@@ -1155,7 +1180,15 @@ def _chart_bounds(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
     return _chart_bounds_numpy(q, r, jump_limit)
 
 
-def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
+def plot_gibbs(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes3D | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    chart_radius: float = 1.0,
+    **style: Any,
+) -> Figure:
     r"""Path of the paper's Gibbs vector :math:`\mathbf n(t)`, in local charts.
 
     The global :math:`\mathbf n` is infinite at the rotation angle
@@ -1251,7 +1284,14 @@ def plot_gibbs(traj, ax=None, fig=None, *, index=0, chart_radius=1.0, **style):
 # ---------------------------------------------------------------------------
 # attitude
 # ---------------------------------------------------------------------------
-def plot_attitude(traj, ax=None, fig=None, *, index=0, **style):
+def plot_attitude(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes3D | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    **style: Any,
+) -> Figure:
     r"""The body's principal axes traced on the unit sphere (space frame).
 
     Curves :math:`R(t)P\mathbf e_i` (:math:`P` the principal axes in the body
@@ -1372,7 +1412,16 @@ def _view_up(model, one) -> tuple[np.ndarray, str]:
     return np.array([0.0, 0.0, 1.0]), "space z"
 
 
-def plot_apex(traj, ax=None, fig=None, *, index=0, axis=None, cmap="viridis", **style):
+def plot_apex(
+    traj: Trajectory | LazyTrajectory,
+    ax: Axes | None = None,
+    fig: Figure | None = None,
+    *,
+    index: int | tuple[int, ...] = 0,
+    axis: ArrayLike | None = None,
+    cmap: str = "viridis",
+    **style: Any,
+) -> Figure:
     r"""The locus of a top's symmetry axis on the unit sphere, seen from above.
 
     The unit vector :math:`\mathbf a(t) = R(t)\mathbf e` of the body axis
@@ -1588,7 +1637,15 @@ def plot(
     return fig
 
 
-def plot_all(traj, out_dir, *, fmt: str = "png", index=0, dpi=None, prefix: str = "") -> dict[str, Path]:
+def plot_all(
+    traj: Trajectory | LazyTrajectory,
+    out_dir: str | os.PathLike[str],
+    *,
+    fmt: str = "png",
+    index: int | tuple[int, ...] = 0,
+    dpi: float | None = None,
+    prefix: str = "",
+) -> dict[str, Path]:
     """Write every kind of picture to ``out_dir/<prefix><kind>.<fmt>``.
 
     Returns

@@ -18,6 +18,7 @@ import os
 import sys
 import time
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -1633,7 +1634,7 @@ def _quiet_warnings(enabled: bool):
             os.environ["PYTHONWARNINGS"] = old
 
 
-def main(argv=None) -> int:
+def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``eulerpoisson`` command; returns the exit status.
 
     Bad input, and any failure of a command, prints one line

@@ -25,7 +25,9 @@ printed); the locus of the axis on the unit sphere is drawn (``top_apex.png``).
 
 from __future__ import annotations
 
+import os
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -66,7 +68,7 @@ TUMBLER: dict[str, Any] = {
 }
 
 
-def run_fit(out, *, say=print) -> list[Path]:
+def run_fit(out: str | os.PathLike[str], *, say: Callable[[str], object] = print) -> list[Path]:
     """The fit scene: synthetic noisy observations of a tumbling body, fitted; ``fit.json`` and a residual plot."""
     from ..estimation import fit
     from ..estimation.residuals import exp_quaternion
@@ -129,7 +131,13 @@ def run_fit(out, *, say=print) -> list[Path]:
 _DRIFT_NAMES = {"m_vertical": "vertical momentum", "M3": "spin momentum M3"}
 
 
-def run_top(out, *, say=print, t_end: float = HEAVY_TOP["t_end"], samples: int = HEAVY_TOP["samples"]) -> list[Path]:
+def run_top(
+    out: str | os.PathLike[str],
+    *,
+    say: Callable[[str], object] = print,
+    t_end: float = HEAVY_TOP["t_end"],
+    samples: int = HEAVY_TOP["samples"],
+) -> list[Path]:
     """The heavy-top scene: ``top.nc`` and ``top_apex.png`` in ``out``; returns the files written.
 
     Solved with ``method="taylor"``; also with ``method="exact"`` when the
@@ -187,7 +195,9 @@ def run_top(out, *, say=print, t_end: float = HEAVY_TOP["t_end"], samples: int =
     return [nc, png]
 
 
-def run_demo(out="out", *, quiet: bool = False, t_end: float = 400.0, samples: int = 4001) -> int:
+def run_demo(
+    out: str | os.PathLike[str] = "out", *, quiet: bool = False, t_end: float = 400.0, samples: int = 4001
+) -> int:
     """Run the tennis-racket showcase and write everything into ``out``.
 
     Parameters

@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 from ..errors import EulerPoissonError
@@ -39,7 +40,7 @@ class OutputError(EulerPoissonError, FileExistsError):
     """An output that may not be written: it exists (no overwrite), is an input, is of another kind, or is locked."""
 
 
-def file_kind(path) -> str | None:
+def file_kind(path: str | os.PathLike[str]) -> str | None:
     """What ``path`` holds: ``"netcdf"``, ``"trajectory-store"``, ``"sweep-store"``, ``"zarr"`` (another store),
     ``"folder"``, ``"file"``, or None when it does not exist."""
     p = Path(path)
@@ -79,7 +80,14 @@ def _same_file(a, b) -> bool:
         return os.path.abspath(a) == os.path.abspath(b)
 
 
-def check_output(path, writes: str, *, overwrite: bool = False, inputs=(), flag: str = "--overwrite") -> None:
+def check_output(
+    path: str | os.PathLike[str],
+    writes: str,
+    *,
+    overwrite: bool = False,
+    inputs: Iterable[str | os.PathLike[str]] = (),
+    flag: str = "--overwrite",
+) -> None:
     """Refuse an output that must not be written (before any work is done).
 
     Parameters

@@ -144,7 +144,7 @@ def available_cores() -> int:
     return max(1, int(n or 1))
 
 
-def check_workers(workers, name: str = "workers") -> int | None:
+def check_workers(workers: object, name: str = "workers") -> int | None:
     """Validate a number of threads: an integer >= 1, or None (the default).
 
     Raises
@@ -166,7 +166,7 @@ def check_workers(workers, name: str = "workers") -> int | None:
     return int(workers)
 
 
-def resolve_workers(workers=None) -> int:
+def resolve_workers(workers: object = None) -> int:
     """The number of threads to use: ``workers``, else ``$EULERPOISSON_WORKERS``, else every core.
 
     Raises

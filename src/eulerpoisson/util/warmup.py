@@ -17,7 +17,7 @@ kernels without importing numba (:func:`eulerpoisson.util.jit.use_compiled`).
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -223,7 +223,9 @@ def _in_processes(groups, jobs, say):
     return results
 
 
-def warmup(only=None, *, say: Callable[[str], None] = print, jobs: int = 1) -> dict[str, float]:
+def warmup(
+    only: str | Iterable[str] | None = None, *, say: Callable[[str], None] = print, jobs: int = 1
+) -> dict[str, float]:
     """Compile (or load from the cache) the kernels of the groups ``only`` (default: every group).
 
     Parameters

@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError, MissingDependencyError
 from ..io.atomic import atomic_path
@@ -132,7 +133,7 @@ def hidden_by_box(points, R, half, axes, eye, *, orthographic=False) -> np.ndarr
 # ---------------------------------------------------------------------------
 # geometry
 # ---------------------------------------------------------------------------
-def box_dimensions(moments, *, min_thickness: float = MIN_THICKNESS) -> np.ndarray:
+def box_dimensions(moments: ArrayLike, *, min_thickness: float = MIN_THICKNESS) -> np.ndarray:
     r"""Side lengths of the uniform box with the given principal moments, scaled to a longest side of 1.
 
     A uniform box of mass :math:`m` and sides :math:`a_1, a_2, a_3` has
@@ -209,7 +210,7 @@ def _face_rgb(axis: int, sign: int) -> list[int]:
     return [int(round(c)) for c in rgb]
 
 
-def slerp_series(t, q, tf) -> np.ndarray:
+def slerp_series(t: ArrayLike, q: ArrayLike, tf: ArrayLike) -> np.ndarray:
     r"""Attitudes at times ``tf`` by spherical linear interpolation of the samples ``(t, q)``.
 
     .. math:: q(s) = \frac{\sin((1-s)\theta)}{\sin\theta}q_i + \frac{\sin(s\theta)}{\sin\theta}q_{i+1},

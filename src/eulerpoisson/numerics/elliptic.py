@@ -132,6 +132,9 @@ _RDJ_QFAC = (0.25 * _R_TOL) ** (-1.0 / 6.0)
 _RC_QFAC = (3.0 * _R_TOL) ** (-1.0 / 8.0)
 #: the R_C terms of R_J use the series of atan(t)/t in e = t^2 for |e| <= 2**-5
 RC_SERIES_MAX = 2.0**-5
+#: the Landen ascent on the real axis starts from sin, cos of its argument by the polynomials
+#: :func:`sin_poly`, :func:`cos_poly` up to this argument (the reduced argument is at most about pi/4)
+SINCOS_POLY_MAX = 0.8
 
 
 # ---------------------------------------------------------------------------
@@ -346,9 +349,17 @@ def _sncndn_real(vn, dv, P):
     error would be amplified by the ascent), ``y`` keeps it to full relative
     precision.
     """
-    s0 = np.sin(vn)
-    c0 = np.cos(vn)
-    h = np.sin(0.5 * vn)
+    # sin, cos by polynomials (vn is at most about pi/4: the argument reduced modulo K, scaled to
+    # the bottom of the chain), the C library beyond SINCOS_POLY_MAX
+    if np.all(vn <= SINCOS_POLY_MAX):
+        s0 = sin_poly(vn)
+        c0 = cos_poly(vn)
+        h = sin_poly(0.5 * vn)
+    else:
+        small = vn <= SINCOS_POLY_MAX
+        s0 = np.where(small, sin_poly(vn), np.sin(vn))
+        c0 = np.where(small, cos_poly(vn), np.cos(vn))
+        h = np.where(small, sin_poly(0.5 * vn), np.sin(0.5 * vn))
     # first-order correction for the low part dv of the argument
     s = s0 + c0 * dv
     c = c0 - s0 * dv
@@ -714,6 +725,41 @@ def _rd(x, y, z):
         + 3.0 * e5 / 26.0
     )
     return (fac * poly / (a * np.sqrt(a)) + 3.0 * acc).reshape(shape)
+
+
+@jitable
+def sin_poly(x):
+    r"""``sin(x)`` for ``|x| <= 0.8`` (:data:`SINCOS_POLY_MAX`) in plain arithmetic (fdlibm's and musl's ``__sin``).
+
+    The minimax polynomial of degree 13 of fdlibm (musl's evaluation order); measured against
+    40-digit references: at most 0.71 ulp on ``[0, 0.8]``. Plain arithmetic, so the NumPy path and
+    the compiled kernels (which inline it and run it in vector lanes, where the C library's ``sin``
+    is a call per element) agree bit for bit.
+    """
+    z = x * x
+    w = z * z
+    r = (
+        8.33333333332248946124e-03
+        + z * (-1.98412698298579493134e-04 + z * 2.75573137070700676789e-06)
+        + z * w * (-2.50507602534068634195e-08 + z * 1.58969099521155010221e-10)
+    )
+    return x + z * x * (-1.66666666666666324348e-01 + z * r)
+
+
+@jitable
+def cos_poly(x):
+    r"""``cos(x)`` for ``|x| <= 0.8`` (:data:`SINCOS_POLY_MAX`) in plain arithmetic (fdlibm's and musl's ``__cos``).
+
+    At most 0.73 ulp on ``[0, 0.8]`` (measured against 40-digit references); see :func:`sin_poly`.
+    """
+    z = x * x
+    w = z * z
+    r = z * (
+        4.16666666666666019037e-02 + z * (-1.38888888888741095749e-03 + z * 2.48015872894767294178e-05)
+    ) + w * w * (-2.75573143513906633035e-07 + z * (2.08757232129817482790e-09 + z * -1.13596475577881948265e-11))
+    hz = 0.5 * z
+    w = 1.0 - hz
+    return w + (((1.0 - w) - hz) + z * r)
 
 
 @jitable

@@ -108,7 +108,10 @@ from ...numerics.doubledouble import split as _split
 from ...numerics.doubledouble import two_prod as _two_prod
 from ...numerics.doubledouble import two_sum as _two_sum
 from ...numerics.elliptic import RC_SERIES_MAX as _RC_SERIES_MAX
+from ...numerics.elliptic import SINCOS_POLY_MAX as _SINCOS_POLY_MAX
+from ...numerics.elliptic import cos_poly as _cos_poly
 from ...numerics.elliptic import rc1_series as _rc1_series
+from ...numerics.elliptic import sin_poly as _sin_poly
 from ...numerics.quaternion import qmul_components as _qmul
 from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
@@ -547,9 +550,15 @@ def _reduce(uh, ul, sep, kh, kl, ph, pcorr):
 
 
 def _real_start(vn, dv):
-    s0 = math.sin(vn)
-    c0 = math.cos(vn)
-    h = math.sin(0.5 * vn)
+    if vn <= _SINCOS_POLY_MAX:
+        # (the reduced argument is at most about pi/4: always, but for safety)
+        s0 = _sin_poly(vn)
+        c0 = _cos_poly(vn)
+        h = _sin_poly(0.5 * vn)
+    else:
+        s0 = math.sin(vn)
+        c0 = math.cos(vn)
+        h = math.sin(0.5 * vn)
     return s0 + c0 * dv, c0 - s0 * dv, 2.0 * h * h + s0 * dv
 
 
@@ -1585,6 +1594,8 @@ if USE_NUMBA:  # pragma: no branch
     _ldexp = _jiti(_ldexp)
     _rf_poly = _jiti(_rf_poly)
     _rc1_series = _jiti(_rc1_series)
+    _sin_poly = _jiti(_sin_poly)
+    _cos_poly = _jiti(_cos_poly)
     _rc1 = _jiti(_rc1)
     _rj_init = _jiti(_rj_init)
     _rj_step = _jiti(_rj_step)

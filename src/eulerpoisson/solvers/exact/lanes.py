@@ -149,6 +149,7 @@ _LANDEN_THRESHOLD = _K._LANDEN_THRESHOLD
 _RF_QFAC = _K._RF_QFAC
 _RDJ_QFAC = _K._RDJ_QFAC
 _RC_SERIES_MAX = _K._RC_SERIES_MAX
+_SINCOS_POLY_MAX = _K._SINCOS_POLY_MAX
 _TWO200 = _K._TWO200
 _TWOM100 = _K._TWOM100
 _TWOM104 = _K._TWOM104
@@ -336,6 +337,16 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         o = g * _L
         for l in range(nl):
             j = o + l
+            # the real path's starting values by the polynomials (kernels._real_start), vector code
+            # for every slot; the other paths overwrite them below
+            vn = W[3 * _NJAC + j]
+            W[6 * _NJAC + j] = _K._sin_poly(vn)
+            W[7 * _NJAC + j] = _K._cos_poly(vn)
+            W[8 * _NJAC + j] = _K._sin_poly(0.5 * vn)
+    for g in range(ng):
+        o = g * _L
+        for l in range(nl):
+            j = o + l
             im = W[5 * _NJAC + j]
             vn = W[3 * _NJAC + j]
             # starting values at the bottom of the chain (library calls)
@@ -344,9 +355,10 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                 W[7 * _NJAC + j] = math.cosh(vn)
                 any_imag = True
             elif im == 0.0:
-                W[6 * _NJAC + j] = math.sin(vn)
-                W[7 * _NJAC + j] = math.cos(vn)
-                W[8 * _NJAC + j] = math.sin(0.5 * vn)
+                if not (vn <= _SINCOS_POLY_MAX):
+                    W[6 * _NJAC + j] = math.sin(vn)
+                    W[7 * _NJAC + j] = math.cos(vn)
+                    W[8 * _NJAC + j] = math.sin(0.5 * vn)
                 any_real = True
             elif im == 2.0:
                 # the separatrix (kernels._finish): tanh, sech of |r|

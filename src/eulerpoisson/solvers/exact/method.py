@@ -71,7 +71,12 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
         return
     tmax = float(np.max(np.abs(problem.t)))
     if speed is None:
-        w2 = np.sum(problem.omega0 * problem.omega0, axis=-1)
+        w = problem.omega0
+        # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
+        wmax = max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
+        if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
+            return
+        w2 = np.sum(w * w, axis=-1)
         # the common case in one pass: every |Omega0| t well inside the range (no square roots)
         if tmax == 0.0 or float(np.max(w2, initial=0.0)) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
             return

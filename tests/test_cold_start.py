@@ -162,7 +162,7 @@ def test_lazy_dispatchers_become_real_ones():
 
     jit.activate()
     assert jit.numba_active()
-    for f in (K.motion_kernel, K.constants_kernel, K._two_sum, SK._nb_rotate, SK._nb_gauss):
+    for f in (K.motion_kernel, K.constants_kernel, K.two_sum, SK._nb_rotate, SK.nb_gauss):
         assert isinstance(f, CPUDispatcher), f
     assert SK._nb_rotate.targetoptions.get("inline") == "always"  # options passed unchanged
     made = jit.lazy_njit(cache=False, nogil=True)(lambda x: x + 1)
@@ -175,7 +175,7 @@ def test_lazy_objects_held_outside_the_package_still_compile():
     code = """
 import json
 from eulerpoisson.solvers.exact import kernels as K
-two_sum, sqrt_ = K._two_sum, K._sqrt
+two_sum, sqrt_ = K.two_sum, K.fast_sqrt
 kinds = [type(two_sum).__name__, type(sqrt_).__name__]
 from numba import njit
 

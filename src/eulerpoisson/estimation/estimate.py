@@ -348,7 +348,7 @@ def fit(
     found, n_equivalent = _prefer_slowest(found)
     best = found[0][1]
     final = evaluate(layout, obs, best.state)
-    return FitResult._from_search(
+    return FitResult.from_search(
         layout, obs, best, final, [f[0] for f in found], estimated, len(start_list), n_equivalent
     )
 

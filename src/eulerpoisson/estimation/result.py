@@ -158,7 +158,7 @@ class FitResult:
     [0.25 0.33 0.42]
     """
 
-    # what _from_search sets (read-only: arrays not writeable, dicts as mappings, lists as tuples)
+    # what from_search sets (read-only: arrays not writeable, dicts as mappings, lists as tuples)
     epoch: float
     inertia: NDArray[np.float64]
     principal_moments: NDArray[np.float64]
@@ -197,7 +197,12 @@ class FitResult:
         raise AttributeError("FitResult is read-only")
 
     @classmethod
-    def _from_search(cls, layout, obs, best, final, optima, estimated, n_starts, n_equivalent=1):
+    def from_search(cls, layout, obs, best, final, optima, estimated, n_starts, n_equivalent=1):
+        """The result of ``fit``'s search: the best optimum, its covariance and the other optima found.
+
+        Made by ``fit`` from its internal state (the parameter layout, the observations, the optima of
+        the starts); not meant to be called directly.
+        """
         I, _ = inertia_matrix(layout, best.state.inertia_params)
         I = I / np.trace(I)
         J = final.jacobian

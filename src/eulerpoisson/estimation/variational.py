@@ -127,7 +127,7 @@ def propagate(inertia, omega0, dinertia, tau, *, tol: float = 2.0**-52) -> Sensi
     w = np.zeros((K, 3))
     eta = np.zeros((K, P, 3))
     dw = np.zeros((K, P, 3))
-    kernel = _propagate_numba if USE_NUMBA else _propagate_numpy
+    kernel = propagate_numba if USE_NUMBA else _propagate_numpy
     status, steps = kernel(inertia, jinv, dinertia, omega0, tau, order, tol, safety, MAX_STEPS, q, w, eta, dw)
     if status == 1:
         raise FloatingPointError(f"the motion needed more than {MAX_STEPS} Taylor steps")
@@ -399,6 +399,6 @@ def _propagate_loops(I, J, dI, omega0, tau, order, tol, safety, max_steps, q, w,
 if USE_NUMBA:
     from ..util.jit import lazy_njit as njit  # made when numba is first used, not at import
 
-    _propagate_numba = njit(cache=True, fastmath={"contract"})(_propagate_loops)
+    propagate_numba = njit(cache=True, fastmath={"contract"})(_propagate_loops)
 else:  # pragma: no cover - depends on environment
-    _propagate_numba = _propagate_loops
+    propagate_numba = _propagate_loops

@@ -100,7 +100,7 @@ _DISPLAY_LIMIT = 2500
 
 
 def _sp():
-    return _sym._sympy()
+    return _sym.sympy_module()
 
 
 class AuditError(EulerPoissonError, RuntimeError):
@@ -1315,7 +1315,7 @@ def _series_residual_zero(D, coeffs, inertia_rep, order) -> tuple[bool, int]:
         free |= set(D.inertia_symbols)
     csyms = sorted(free - set(phase), key=lambda s: s.name)
     known = [D.detI] if (D.inertia == "general" and not inertia_rep) else []
-    ctx = _sym._Ctx(phase + csyms, known)
+    ctx = _sym.Ctx(phase + csyms, known)
     # Hamilton's vector field (dH/dpi, -dH/dn) of the derived H, moved into this ring
     Xf = list(D._fndot_c) + list(D._fpidot_c)
     X = [_transfer(x, D.ctx, ctx, inertia_rep) for x in Xf]
@@ -1344,13 +1344,13 @@ def _series_residual_zero(D, coeffs, inertia_rep, order) -> tuple[bool, int]:
             groups.setdefault(key, []).append((rest, c))
         acc = [zero] * K
         for key, terms in groups.items():
-            coef = _sym._Rat(ctx, ctx.ring.from_terms(terms), {})
+            coef = _sym.Rat(ctx, ctx.ring.from_terms(terms), {})
             ser = [coef] + [zero] * (K - 1)
             for b, e in enumerate(key):
                 if e:
                     ser = mul(ser, power(b, e))
             acc = [x + y for x, y in zip(acc, ser)]
-        den = _sym._Rat(ctx, ctx.ring.one, dict(Xa.den))
+        den = _sym.Rat(ctx, ctx.ring.one, dict(Xa.den))
         for k in range(K):
             res = ctx.from_expr((k + 1) * coeffs[k + 1, a]) - acc[k] * den
             if not res.normalize().is_zero():
@@ -1403,7 +1403,7 @@ def _transfer(rat, src, dst, values):
         num = num * (1 / c) ** e
         for kk, ee in exps.items():
             den[kk] = den.get(kk, 0) + ee * e
-    return _sym._Rat(dst, num, den)
+    return _sym.Rat(dst, num, den)
 
 
 def _lie_symbolic_check(D, order):

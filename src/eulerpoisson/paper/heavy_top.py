@@ -86,11 +86,11 @@ def _cross(u, v):
 
 
 def _rdot(ctx, u, v):
-    return _S._rsum((u[i] * v[i] for i in range(3)), ctx).normalize()
+    return _S.rsum((u[i] * v[i] for i in range(3)), ctx).normalize()
 
 
 def _scale(ctx, c, u):
-    c = ctx.from_expr(c) if not isinstance(c, _S._Rat) else c
+    c = ctx.from_expr(c) if not isinstance(c, _S.Rat) else c
     return [(c * x).normalize() for x in u]
 
 
@@ -122,7 +122,7 @@ class HeavyTopDerivation:
     """
 
     def __init__(self, inertia: str = "general"):
-        sp = _S._sympy()
+        sp = _S.sympy_module()
         base = _S.derive(inertia)
         self.base = base
         self.inertia = inertia
@@ -133,7 +133,7 @@ class HeavyTopDerivation:
         self.g = sp.Matrix(sp.symbols("g1:4", real=True))
         gens = list(base.ctx.symbols) + [self.mass] + list(self.c) + list(self.g)
         known = [1 + base.nsq] + ([base.detI] if inertia == "general" else list(base.inertia_symbols))
-        self.ctx = C = _S._Ctx(gens, known)
+        self.ctx = C = _S.Ctx(gens, known)
         self._fn, self._fnd, self._fpi = C.vec(self.n), C.vec(self.ndot), C.vec(self.pi)
         self._fc, self._fg = C.vec(self.c), C.vec(self.g)
         self._fmass = C.from_expr(self.mass)
@@ -177,7 +177,7 @@ class HeavyTopDerivation:
     # -- Lagrangian ------------------------------------------------------------
     @cached_property
     def _fU(self):
-        Rc = _S._rmm(self._fR, self._fc)
+        Rc = _S.rmm(self._fR, self._fc)
         return (-(self._fmass * _rdot(self.ctx, self._fg, Rc))).normalize()
 
     @cached_property
@@ -214,7 +214,7 @@ class HeavyTopDerivation:
 
     @cached_property
     def _fvelocity(self):
-        return _S._rmm(_S._rinv3(self._fG), self._fpi)
+        return _S.rmm(_S.rinv3(self._fG), self._fpi)
 
     @cached_property
     def velocity_of_momenta(self):
@@ -238,8 +238,8 @@ class HeavyTopDerivation:
     @cached_property
     def _fH0(self):
         C = self.ctx
-        u = _S._rmm(self._fAtilde, self._fpi)
-        return (C.const(_S._sympy().Rational(1, 8)) * _rdot(C, u, _S._rmm(self._fIinv, u))).normalize()
+        u = _S.rmm(self._fAtilde, self._fpi)
+        return (C.const(_S.sympy_module().Rational(1, 8)) * _rdot(C, u, _S.rmm(self._fIinv, u))).normalize()
 
     @cached_property
     def H0(self):
@@ -279,7 +279,7 @@ class HeavyTopDerivation:
     @cached_property
     def _ftorque(self):
         C = self.ctx
-        gamma = _S._rmm(_S._rtr(self._fR), self._fg)  # R^T g
+        gamma = _S.rmm(_S.rtr(self._fR), self._fg)  # R^T g
         return _cross(self._fc, _scale(C, self._fmass, gamma))
 
     @cached_property
@@ -290,7 +290,7 @@ class HeavyTopDerivation:
     @cached_property
     def _fOmega(self):
         C = self.ctx
-        return _scale(C, _S._sympy().Rational(1, 2), _S._rmm(self._fIinv, _S._rmm(self._fAtilde, self._fpi)))
+        return _scale(C, _S.sympy_module().Rational(1, 2), _S.rmm(self._fIinv, _S.rmm(self._fAtilde, self._fpi)))
 
     @cached_property
     def Omega(self):
@@ -300,13 +300,13 @@ class HeavyTopDerivation:
     @cached_property
     def _fpidot_closed(self):
         C = self.ctx
-        sp = _S._sympy()
+        sp = _S.sympy_module()
         n, p, W = self._fn, self._fpi, self._fOmega
         npi, nw = _rdot(C, n, p), _rdot(C, n, W)
         c = _cross(W, p)
         half = C.const(sp.Rational(-1, 2))
         free = [(half * (npi * W[i] + nw * p[i] + c[i])).normalize() for i in range(3)]
-        tq = _scale(C, 2, _S._rmm(self._fA, self._ftorque))
+        tq = _scale(C, 2, _S.rmm(self._fA, self._ftorque))
         return [(a + b).normalize() for a, b in zip(free, tq)]
 
     @cached_property
@@ -317,7 +317,7 @@ class HeavyTopDerivation:
     @cached_property
     def vector_field(self):
         r"""The heavy top's canonical vector field :math:`(\dot{\mathbf n}, \dot{\boldsymbol\pi})`, a (6, 1) matrix."""
-        sp = _S._sympy()
+        sp = _S.sympy_module()
         return sp.Matrix(list(self.ndot_hamilton) + list(self.pidot))
 
     # -- exact checks ------------------------------------------------------------
@@ -327,9 +327,9 @@ class HeavyTopDerivation:
     def _identity(self, name):
         C, b = self.ctx, self.base
         if name == "momenta_are_G_ndot":
-            return self._zero(_sub(self._fmomenta, _S._rmm(C.mat(b.G), self._fnd)))
+            return self._zero(_sub(self._fmomenta, _S.rmm(C.mat(b.G), self._fnd)))
         if name == "metric_is_4AIAt":
-            AIAt = _S._rmm(_S._rmm(self._fA, self._fI), _S._rtr(self._fA))
+            AIAt = _S.rmm(_S.rmm(self._fA, self._fI), _S.rtr(self._fA))
             return self._zero([g - 4 * x for rg, ra in zip(self._fG, AIAt) for g, x in zip(rg, ra)])
         if name == "H_is_H0_plus_U":
             return self._zero([self._fH - self._fH0 - self._fU])
@@ -338,20 +338,20 @@ class HeavyTopDerivation:
         if name == "pidot_is_minus_dH0_dn_minus_dU_dn":
             return self._zero([self._fpidot[i] + self._fH0.diff(self.n[i]) + self._fdU[i] for i in range(3)])
         if name == "dU_dn_is_minus_2A_tau":
-            tq = _S._rmm(self._fA, self._ftorque)
+            tq = _S.rmm(self._fA, self._ftorque)
             return self._zero([self._fdU[i] + 2 * tq[i] for i in range(3)])
         if name == "pidot_closed_form":
             return self._zero(_sub(self._fpidot, self._fpidot_closed))
         if name == "euler_equations":
             # M = I Omega(n, pi) from eq. 1.10, Mdot = {M, H} = M x Omega + tau
             Om = C.vec(b.Omega_canonical)
-            M = _S._rmm(self._fI, Om)
+            M = _S.rmm(self._fI, Om)
             Md = [self._fbracket(x, self._fH) for x in M]
             rhs = [a + t for a, t in zip(_cross(M, Om), self._ftorque)]
             return self._zero(_sub(Md, rhs))
         if name == "poisson_equation":
             # gamma = R^T g, gammadot = {gamma, H} = gamma x Omega
-            gamma = _S._rmm(_S._rtr(self._fR), self._fg)
+            gamma = _S.rmm(_S.rtr(self._fR), self._fg)
             gd = [self._fbracket(x, self._fH) for x in gamma]
             return self._zero(_sub(gd, _cross(gamma, self._fOmega)))
         if name == "vertical_momentum_conserved":
@@ -413,7 +413,7 @@ class HeavyTopDerivation:
 
     # -- exact evaluation ----------------------------------------------------------
     def _values(self, n, pi, inertia, mass, center_of_mass, g):
-        sp = _S._sympy()
+        sp = _S.sympy_module()
         vals: dict[Any, Any] = {}
         vals.update(zip(self.n, _exact_vector(n, "n")))
         vals.update(zip(self.pi, _exact_vector(pi, "pi")))
@@ -491,7 +491,7 @@ def _exact_scalar(x, name):
     if isinstance(x, (bool, np.bool_)) or isinstance(x, (str, bytes)):
         raise TypeError(f"{name} must be a real number, got {x!r}")
     try:
-        sp = _S._sympy()
+        sp = _S.sympy_module()
         if isinstance(x, sp.Rational):
             return Fraction(int(x.p), int(x.q))
     except Exception:  # pragma: no cover - sympy always importable here

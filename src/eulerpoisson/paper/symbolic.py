@@ -93,7 +93,7 @@ MAX_LIE_ORDER = 16
 _SYMPY = None
 
 
-def _sympy():
+def sympy_module():
     global _SYMPY
     if _SYMPY is None:
         _SYMPY = require("sympy", "symbolic")
@@ -136,7 +136,7 @@ def hat(v):
     -------
     sympy.Matrix, shape (3, 3)
     """
-    sp = _sympy()
+    sp = sympy_module()
     return sp.Matrix(3, 3, lambda i, j: sum(levi_civita(i, j, p) * v[p] for p in range(3)))
 
 
@@ -151,7 +151,7 @@ def cross(u, v):
     -------
     sympy.Matrix, shape (3, 1)
     """
-    sp = _sympy()
+    sp = sympy_module()
     return sp.Matrix(3, 1, lambda i, _: sum(levi_civita(i, j, k) * u[j] * v[k] for j in range(3) for k in range(3)))
 
 
@@ -213,11 +213,11 @@ def rsimp(expr):
         If ``expr`` is not a rational function of its symbols, or divides by
         an identically vanishing expression.
     """
-    sp = _sympy()
+    sp = sympy_module()
     expr = sp.sympify(expr)
     if expr.is_Number:
         return expr
-    ctx = _Ctx(sorted(expr.free_symbols, key=lambda s: s.name))
+    ctx = Ctx(sorted(expr.free_symbols, key=lambda s: s.name))
     return ctx.from_expr(expr).normalize().expr()
 
 
@@ -228,11 +228,11 @@ def rsimp_matrix(M):
 
 def is_zero(expr) -> bool:
     """True if the rational expression ``expr`` is identically zero (exact test, see :func:`rsimp`)."""
-    sp = _sympy()
+    sp = sympy_module()
     expr = sp.sympify(expr)
     if expr.is_Number:
         return bool(expr == 0)
-    ctx = _Ctx(sorted(expr.free_symbols, key=lambda s: s.name))
+    ctx = Ctx(sorted(expr.free_symbols, key=lambda s: s.name))
     return ctx.from_expr(expr).is_zero()
 
 
@@ -255,7 +255,7 @@ def inverse3(M):
     InvalidInputError
         If ``M`` is not 3x3 or is singular.
     """
-    sp = _sympy()
+    sp = sympy_module()
     if not isinstance(M, sp.MatrixBase) or M.shape != (3, 3):
         raise InvalidInputError(
             f"inverse3: M must be a sympy Matrix of shape (3, 3), got {getattr(M, 'shape', type(M))}"
@@ -263,8 +263,8 @@ def inverse3(M):
     syms = set()
     for e in M:
         syms |= sp.sympify(e).free_symbols
-    ctx = _Ctx(sorted(syms, key=lambda s: s.name) or [sp.Dummy("x")])
-    return ctx.to_matrix(_rinv3(ctx.mat(M)))
+    ctx = Ctx(sorted(syms, key=lambda s: s.name) or [sp.Dummy("x")])
+    return ctx.to_matrix(rinv3(ctx.mat(M)))
 
 
 # ---------------------------------------------------------------------------
@@ -300,7 +300,7 @@ def poisson_bracket(f, g, n, pi):
     InvalidInputError
         If ``n`` and ``pi`` have different lengths or contain non-symbols.
     """
-    sp = _sympy()
+    sp = sympy_module()
     n = list(n)
     pi = list(pi)
     if len(n) != len(pi) or not n:
@@ -348,7 +348,7 @@ def rotation_from_axis_angle(k, cos_a, sin_a):
     -------
     sympy.Matrix, shape (3, 3)
     """
-    sp = _sympy()
+    sp = sympy_module()
     x = sp.Matrix(sp.symbols("x_1:4"))
     P = k * k.T
     N = sp.eye(3) - P
@@ -373,7 +373,7 @@ def rotation_from_quaternion(q0, q):
     -------
     sympy.Matrix, shape (3, 3)
     """
-    sp = _sympy()
+    sp = sympy_module()
     qq = dot(q, q)
     qx = -hat(q)
     return ((q0**2 - qq) * sp.eye(3) + 2 * q * q.T + 2 * q0 * qx) / (q0**2 + qq)
@@ -389,7 +389,7 @@ def rotation_from_quaternion(q0, q):
 # ---------------------------------------------------------------------------
 
 
-class _Ctx:
+class Ctx:
     """Polynomial ring over QQ plus a growing list of denominator factors (private).
 
     Rational functions are kept as ``num / prod(factor_k ** e_k)``; sums,
@@ -400,7 +400,7 @@ class _Ctx:
     """
 
     def __init__(self, symbols, factors=()):
-        sp = _sympy()
+        sp = sympy_module()
         from sympy.polys.rings import ring
 
         self.symbols = tuple(symbols)
@@ -462,20 +462,20 @@ class _Ctx:
         return self.from_expr(c)
 
     def gen(self, s):
-        return _Rat(self, self.gens[s], {})
+        return Rat(self, self.gens[s], {})
 
     def from_expr(self, expr):
         """Convert a rational SymPy expression (recursively, no gcd)."""
-        sp = _sympy()
+        sp = sympy_module()
         expr = sp.sympify(expr)
         if expr.is_Number:
             if not expr.is_Rational:
                 raise InvalidInputError(f"only rational numbers are supported, got {expr}")
-            return _Rat(self, self.ring(sp.QQ(int(expr.p), int(expr.q))), {})
+            return Rat(self, self.ring(sp.QQ(int(expr.p), int(expr.q))), {})
         if expr.is_Symbol:
             if expr not in self.gens:
                 raise InvalidInputError(f"symbol {expr} is not a generator of this context")
-            return _Rat(self, self.gens[expr], {})
+            return Rat(self, self.gens[expr], {})
         if expr.is_Add:
             acc = None
             for a in expr.args:
@@ -508,13 +508,13 @@ class _Ctx:
         return self._fexpr[i]
 
     def to_matrix(self, X):
-        sp = _sympy()
+        sp = sympy_module()
         if X and isinstance(X[0], list):
             return sp.Matrix(len(X), len(X[0]), lambda i, j: X[i][j].expr())
         return sp.Matrix([x.expr() for x in X])
 
     def subs(self, f, mapping):
-        """Substitute rational functions for generators in ``f`` (a _Rat)."""
+        """Substitute rational functions for generators in ``f`` (a Rat)."""
         if not mapping:
             return f
         R = self.ring
@@ -581,11 +581,11 @@ class _Ctx:
             for k, ek in E.items():
                 den[k] = den.get(k, 0) + ek * dN
             num = N * qpow(dD) * (1 / c) if dD else N * (1 / c)
-            return _Rat(self, num, {k: e for k, e in den.items() if e}).normalize()
+            return Rat(self, num, {k: e for k, e in den.items() if e}).normalize()
         den = dict(f.den)
         for k, ek in E.items():
             den[k] = den.get(k, 0) + ek * dN
-        return _Rat(self, N, {k: e for k, e in den.items() if e}).normalize()
+        return Rat(self, N, {k: e for k, e in den.items() if e}).normalize()
 
     def subs_all(self, X, mapping):
         if X and isinstance(X[0], list):
@@ -599,8 +599,8 @@ class _Ctx:
         return acc.normalize()
 
 
-class _Rat:
-    """``num / prod(ctx.factors[k] ** den[k])`` (private; see :class:`_Ctx`)."""
+class Rat:
+    """``num / prod(ctx.factors[k] ** den[k])`` (private; see :class:`Ctx`)."""
 
     __slots__ = ("ctx", "num", "den")
 
@@ -610,7 +610,7 @@ class _Rat:
         self.den = den
 
     def _lift(self, other):
-        if isinstance(other, _Rat):
+        if isinstance(other, Rat):
             return other
         return self.ctx.from_expr(other)
 
@@ -635,12 +635,12 @@ class _Rat:
         if not self.num:
             return other
         a, b, E = self._common(other)
-        return _Rat(self.ctx, a + b, E)
+        return Rat(self.ctx, a + b, E)
 
     __radd__ = __add__
 
     def __neg__(self):
-        return _Rat(self.ctx, -self.num, dict(self.den))
+        return Rat(self.ctx, -self.num, dict(self.den))
 
     def __sub__(self, other):
         return self + (-self._lift(other))
@@ -651,11 +651,11 @@ class _Rat:
     def __mul__(self, other):
         other = self._lift(other)
         if not self.num or not other.num:
-            return _Rat(self.ctx, self.ctx.ring.zero, {})
+            return Rat(self.ctx, self.ctx.ring.zero, {})
         den = dict(self.den)
         for k, e in other.den.items():
             den[k] = den.get(k, 0) + e
-        return _Rat(self.ctx, self.num * other.num, den)
+        return Rat(self.ctx, self.num * other.num, den)
 
     __rmul__ = __mul__
 
@@ -668,7 +668,7 @@ class _Rat:
         den = dict(self.den)
         for k, e in exps.items():
             den[k] = den.get(k, 0) + e
-        return _Rat(self.ctx, num, den).normalize()
+        return Rat(self.ctx, num, den).normalize()
 
     def __rtruediv__(self, other):
         return self._lift(other) / self
@@ -676,7 +676,7 @@ class _Rat:
     def __pow__(self, e):
         if e < 0:
             return (self.ctx.const(1) / self) ** (-e)
-        return _Rat(self.ctx, self.num**e, {k: v * e for k, v in self.den.items()})
+        return Rat(self.ctx, self.num**e, {k: v * e for k, v in self.den.items()})
 
     def __bool__(self):
         return bool(self.num)
@@ -690,7 +690,7 @@ class _Rat:
         i = ctx.index[sym]
         dep = [k for k in self.den if ctx.factors[k].degree(i) > 0]
         if not dep:
-            return _Rat(ctx, self.num.diff(x), dict(self.den))
+            return Rat(ctx, self.num.diff(x), dict(self.den))
         # d(N / prod f^e) = [N' prod_dep f - N sum_k e_k f_k' prod_{j != k} f_j] / (prod f^e * prod_dep f)
         prod_all = ctx.ring.one
         for k in dep:
@@ -705,11 +705,11 @@ class _Rat:
         den = dict(self.den)
         for k in dep:
             den[k] += 1
-        return _Rat(ctx, num, den).normalize()
+        return Rat(ctx, num, den).normalize()
 
     def normalize(self):
         if not self.num:
-            return _Rat(self.ctx, self.num, {})
+            return Rat(self.ctx, self.num, {})
         num = self.num
         den = {}
         for k, e in self.den.items():
@@ -722,10 +722,10 @@ class _Rat:
                 e -= 1
             if e:
                 den[k] = e
-        return _Rat(self.ctx, num, den)
+        return Rat(self.ctx, num, den)
 
     def expr(self):
-        sp = _sympy()
+        sp = sympy_module()
         num = self.num.as_expr()
         if not self.den:
             return num
@@ -735,33 +735,33 @@ class _Rat:
         return num / d
 
     def __repr__(self):  # pragma: no cover - debugging aid
-        return f"_Rat({self.expr()})"
+        return f"Rat({self.expr()})"
 
 
-def _rsum(items, ctx):
+def rsum(items, ctx):
     acc = ctx.const(0)
     for x in items:
         acc = acc + x
     return acc
 
 
-def _rmm(X, Y):
-    """Product of nested-list _Rat matrices (or matrix times vector)."""
+def rmm(X, Y):
+    """Product of nested-list Rat matrices (or matrix times vector)."""
     ctx = X[0][0].ctx
     if Y and not isinstance(Y[0], list):
-        return [_rsum((X[i][k] * Y[k] for k in range(len(Y))), ctx).normalize() for i in range(len(X))]
+        return [rsum((X[i][k] * Y[k] for k in range(len(Y))), ctx).normalize() for i in range(len(X))]
     return [
-        [_rsum((X[i][k] * Y[k][j] for k in range(len(Y))), ctx).normalize() for j in range(len(Y[0]))]
+        [rsum((X[i][k] * Y[k][j] for k in range(len(Y))), ctx).normalize() for j in range(len(Y[0]))]
         for i in range(len(X))
     ]
 
 
-def _rtr(X):
+def rtr(X):
     return [list(r) for r in zip(*X)]
 
 
-def _rinv3(F):
-    """Inverse of a 3x3 _Rat matrix (private).
+def rinv3(F):
+    """Inverse of a 3x3 Rat matrix (private).
 
     Writes ``F = P / D`` with a polynomial matrix ``P`` and a common
     denominator ``D`` over the known factors, then
@@ -803,7 +803,7 @@ def _rinv3(F):
             minor = P[r[0]][cc[0]] * P[r[1]][cc[1]] - P[r[0]][cc[1]] * P[r[1]][cc[0]]
             if (i + j) % 2:
                 minor = -minor
-            out[i][j] = _Rat(ctx, minor * scale, dict(exps)).normalize()
+            out[i][j] = Rat(ctx, minor * scale, dict(exps)).normalize()
     return out
 
 
@@ -836,7 +836,7 @@ class Derivation:
     """
 
     def __init__(self, inertia: str = "general"):
-        sp = _sympy()
+        sp = sympy_module()
         if inertia not in INERTIA_KINDS:
             raise InvalidInputError(f"inertia must be one of {INERTIA_KINDS}, got {inertia!r}")
         self.inertia = inertia
@@ -869,10 +869,10 @@ class Derivation:
             + list(self.inertia_symbols)
         )
         known = [1 + self.nsq] + ([self.detI] if inertia == "general" else list(self.inertia_symbols))
-        self.ctx = _Ctx(gens, known)
+        self.ctx = Ctx(gens, known)
         C = self.ctx
         self._fI = C.mat(self.I)
-        self._fIinv = _rinv3(self._fI)
+        self._fIinv = rinv3(self._fI)
         self.Iinv = C.to_matrix(self._fIinv)
         self._fn, self._fnd, self._fndd, self._fpi = (C.vec(v) for v in (self.n, self.ndot, self.nddot, self.pi))
 
@@ -893,7 +893,7 @@ class Derivation:
 
     @cached_property
     def _fR(self):
-        sp = _sympy()
+        sp = sympy_module()
         t = sp.Symbol("t", positive=True)
         Rt = rotation_from_axis_angle(self.n / t, (1 - t**2) / (1 + t**2), 2 * t / (1 + t**2))
         Rt = Rt.applyfunc(lambda e: sp.cancel(e).subs(t, sp.sqrt(self.nsq)))
@@ -913,24 +913,24 @@ class Derivation:
         """
         if ndot is None:
             return self.ctx.to_matrix(self._fRdot())
-        sp = _sympy()
+        sp = sympy_module()
         return sp.Matrix(3, 3, lambda i, j: sum(sp.diff(self.R[i, j], self.n[l]) * ndot[l] for l in range(3)))
 
     def _fRdot(self):
         return [
             [
-                _rsum((self._fR[i][j].diff(self.n[l]) * self._fnd[l] for l in range(3)), self.ctx).normalize()
+                rsum((self._fR[i][j].diff(self.n[l]) * self._fnd[l] for l in range(3)), self.ctx).normalize()
                 for j in range(3)
             ]
             for i in range(3)
         ]
 
     def _axial(self, W):
-        sp = _sympy()
+        sp = sympy_module()
         half = self.ctx.from_expr(sp.Rational(-1, 2))
         return [
             (
-                _rsum(
+                rsum(
                     (W[i][j] * levi_civita(k, i, j) for i in range(3) for j in range(3) if levi_civita(k, i, j)),
                     self.ctx,
                 )
@@ -941,7 +941,7 @@ class Derivation:
 
     @cached_property
     def _fOmega_v(self):
-        return self._axial(_rmm(_rtr(self._fR), self._fRdot()))
+        return self._axial(rmm(rtr(self._fR), self._fRdot()))
 
     @cached_property
     def Omega_of_velocity(self):
@@ -950,7 +950,7 @@ class Derivation:
 
     @cached_property
     def _fomega_v(self):
-        return self._axial(_rmm(self._fRdot(), _rtr(self._fR)))
+        return self._axial(rmm(self._fRdot(), rtr(self._fR)))
 
     @cached_property
     def omega_of_velocity(self):
@@ -959,7 +959,7 @@ class Derivation:
 
     @cached_property
     def _fA(self):
-        half = self.ctx.from_expr(_sympy().Rational(1, 2))
+        half = self.ctx.from_expr(sympy_module().Rational(1, 2))
         J = [[self._fOmega_v[i].diff(self.ndot[j]) for j in range(3)] for i in range(3)]
         return [[J[j][i] * half for j in range(3)] for i in range(3)]
 
@@ -970,7 +970,7 @@ class Derivation:
 
     @cached_property
     def _fAtilde(self):
-        return _rinv3(self._fA)
+        return rinv3(self._fA)
 
     @cached_property
     def Atilde(self):
@@ -980,11 +980,9 @@ class Derivation:
     # -- Lagrangian --------------------------------------------------------
     @cached_property
     def _fL(self):
-        half = self.ctx.from_expr(_sympy().Rational(1, 2))
+        half = self.ctx.from_expr(sympy_module().Rational(1, 2))
         Om = self._fOmega_v
-        return (
-            _rsum((self._fI[i][j] * Om[i] * Om[j] for i in range(3) for j in range(3)), self.ctx) * half
-        ).normalize()
+        return (rsum((self._fI[i][j] * Om[i] * Om[j] for i in range(3) for j in range(3)), self.ctx) * half).normalize()
 
     @cached_property
     def L(self):
@@ -1011,7 +1009,7 @@ class Derivation:
 
     @cached_property
     def _fGinv(self):
-        return _rinv3(self._fG)
+        return rinv3(self._fG)
 
     @cached_property
     def Ginv(self):
@@ -1024,7 +1022,7 @@ class Derivation:
 
     @cached_property
     def _fchristoffel_first(self):
-        half = self.ctx.from_expr(_sympy().Rational(1, 2))
+        half = self.ctx.from_expr(sympy_module().Rational(1, 2))
         dG = self._fdG
         return [
             [[((dG[j][i][k] + dG[k][i][j] - dG[i][j][k]) * half).normalize() for k in range(3)] for j in range(3)]
@@ -1042,7 +1040,7 @@ class Derivation:
         Gi = self._fGinv
         return [
             [
-                [_rsum((Gi[i][l] * G1[l][j][k] for l in range(3)), self.ctx).normalize() for k in range(3)]
+                [rsum((Gi[i][l] * G1[l][j][k] for l in range(3)), self.ctx).normalize() for k in range(3)]
                 for j in range(3)
             ]
             for i in range(3)
@@ -1058,7 +1056,7 @@ class Derivation:
         out = []
         for i in range(3):
             p_i = self._fmomenta[i]
-            dt = _rsum(
+            dt = rsum(
                 (p_i.diff(self.n[j]) * self._fnd[j] + p_i.diff(self.ndot[j]) * self._fndd[j] for j in range(3)),
                 self.ctx,
             )
@@ -1079,7 +1077,7 @@ class Derivation:
         nd = self._fnd
         return [
             (
-                self._fndd[i] + _rsum((G2[i][j][k] * nd[j] * nd[k] for j in range(3) for k in range(3)), self.ctx)
+                self._fndd[i] + rsum((G2[i][j][k] * nd[j] * nd[k] for j in range(3) for k in range(3)), self.ctx)
             ).normalize()
             for i in range(3)
         ]
@@ -1092,7 +1090,7 @@ class Derivation:
     @cached_property
     def _fvelocity(self):
         # pi = dL/dndot = G ndot (L is quadratic in ndot), solved with the exact inverse
-        return _rmm(self._fGinv, self._fpi)
+        return rmm(self._fGinv, self._fpi)
 
     @cached_property
     def velocity_of_momenta(self):
@@ -1103,15 +1101,15 @@ class Derivation:
     @cached_property
     def euler_homogeneity(self):
         r""":math:`\dot n_i\,\partial L/\partial\dot n_i - 2L` (zero: :math:`L` is quadratic in :math:`\dot{\mathbf n}`)."""
-        return (_rsum((self._fnd[i] * self._fmomenta[i] for i in range(3)), self.ctx) - self._fL * 2).normalize().expr()
+        return (rsum((self._fnd[i] * self._fmomenta[i] for i in range(3)), self.ctx) - self._fL * 2).normalize().expr()
 
     @cached_property
     def _fH(self):
         # Legendre transform H = pi.v - L(v) at the velocity v(n, pi) solving pi = dL/dndot.
         # L is homogeneous of degree 2 in ndot (see euler_homogeneity), so L(v) = v.pi(v)/2 = v.pi/2.
         v = self._fvelocity
-        half = self.ctx.from_expr(_sympy().Rational(1, 2))
-        return (_rsum((self._fpi[i] * v[i] for i in range(3)), self.ctx) * half).normalize()
+        half = self.ctx.from_expr(sympy_module().Rational(1, 2))
+        return (rsum((self._fpi[i] * v[i] for i in range(3)), self.ctx) * half).normalize()
 
     @cached_property
     def H(self):
@@ -1159,7 +1157,7 @@ class Derivation:
 
     @cached_property
     def _fM_c(self):
-        return _rmm(self._fI, self._fOmega_c)
+        return rmm(self._fI, self._fOmega_c)
 
     @cached_property
     def M_canonical(self):
@@ -1168,7 +1166,7 @@ class Derivation:
 
     @cached_property
     def _fm_c(self):
-        return _rmm(self._fR, self._fM_c)
+        return rmm(self._fR, self._fM_c)
 
     @cached_property
     def m_canonical(self):
@@ -1177,7 +1175,7 @@ class Derivation:
 
     def _solve_linear_in_pi(self, fexpr, target):
         J = [[fexpr[i].diff(p) for p in self.pi] for i in range(3)]
-        return _rmm(_rinv3(J), self.ctx.vec(target))
+        return rmm(rinv3(J), self.ctx.vec(target))
 
     @cached_property
     def _fpi_of(self):
@@ -1233,7 +1231,7 @@ class Derivation:
         InvalidInputError
             For an unknown chart.
         """
-        sp = _sympy()
+        sp = sympy_module()
         C = self.ctx
         if isinstance(expr, sp.MatrixBase):
             return C.to_matrix(self._chart(C.mat(expr), chart))
@@ -1340,7 +1338,7 @@ class Derivation:
         InvalidInputError
             For an unknown chart.
         """
-        sp = _sympy()
+        sp = sympy_module()
         Z = sp.zeros(3, 3)
         if chart == "canonical":
             return sp.BlockMatrix([[Z, sp.eye(3)], [-sp.eye(3), Z]]).as_explicit()
@@ -1393,7 +1391,7 @@ def _check_order(order) -> int:
 
 
 def _to_rational(x, name):
-    sp = _sympy()
+    sp = sympy_module()
     if isinstance(x, sp.Basic):
         return x
     if isinstance(x, (bool, np.bool_)):
@@ -1418,7 +1416,7 @@ def _inverse_inertia(inertia):
     maps them to the entries of I^{-1} in terms of the inertia symbols of
     :func:`derive`; for numeric inertia K is exact and ``back`` is None.
     """
-    sp = _sympy()
+    sp = sympy_module()
     if inertia is None or (isinstance(inertia, str) and inertia == "general"):
         ks = sp.symbols("K11 K12 K13 K22 K23 K33")
         K = sp.Matrix([[ks[0], ks[1], ks[2]], [ks[1], ks[3], ks[4]], [ks[2], ks[4], ks[5]]])
@@ -1456,7 +1454,7 @@ def _inverse_inertia(inertia):
 
 
 def _vector_arg(v, name):
-    sp = _sympy()
+    sp = sympy_module()
     if isinstance(v, sp.MatrixBase):
         vals = list(v)
     else:
@@ -1471,7 +1469,7 @@ def _vector_arg(v, name):
 
 def _lie_coefficients(order, K, pi0, n0, back):
     """Lie-series coefficients as a list of rows of 6 SymPy expressions (private)."""
-    sp = _sympy()
+    sp = sympy_module()
     params = set()
     for e in list(K) + list(pi0) + list(n0):
         params |= e.free_symbols
@@ -1484,7 +1482,7 @@ def _lie_coefficients(order, K, pi0, n0, back):
     ordered = sorted(params, key=lambda s: s.name)
     dsyms = sp.symbols("_d1:4")
     psyms = sp.symbols("_p1:4")
-    ctx = _Ctx(list(dsyms) + list(psyms) + ordered + extra, known)
+    ctx = Ctx(list(dsyms) + list(psyms) + ordered + extra, known)
     R = ctx.ring
     d_ = [ctx.gens[x] for x in dsyms]
     p_ = [ctx.gens[x] for x in psyms]
@@ -1547,7 +1545,7 @@ def _lie_coefficients(order, K, pi0, n0, back):
         row = []
         for f in current:
             f0 = R.from_dict({mon: c for mon, c in f.items() if mon[0] == mon[1] == mon[2] == 0})
-            r = ctx.subs(_Rat(ctx, f0, {}), dict(zip(psyms, pi0r)))
+            r = ctx.subs(Rat(ctx, f0, {}), dict(zip(psyms, pi0r)))
             if mapping_back:
                 r = ctx.subs(r, mapping_back)
             row.append((r * sp.Rational(1, fact)).normalize().expr())
@@ -1567,7 +1565,7 @@ _LIE_STORE_SIZE = 32
 
 @functools.lru_cache(maxsize=8)
 def _lie_cached(order, inertia_key, pi0_key, n0_key):
-    sp = _sympy()
+    sp = sympy_module()
     inertia = inertia_key if isinstance(inertia_key, str) else sp.Matrix(3, 3, list(inertia_key))
     K, back = _inverse_inertia(inertia)
     pi0 = sp.Matrix(list(pi0_key))
@@ -1623,7 +1621,7 @@ def taylor_coefficients(order: int, inertia=None, pi0=None, n0=None, *, as_float
     Paper eq. 1.23.1; Deriglazov, Universe 8 (2022) 536 (exponential of the
     Hamiltonian vector field).
     """
-    sp = _sympy()
+    sp = sympy_module()
     order = _check_order(order)
     ikey: str | tuple[Any, ...]
     if inertia is None or isinstance(inertia, str):
@@ -1682,7 +1680,7 @@ def lie_series(order: int, inertia=None, pi0=None, n0=None, t=None):
     >>> n_t.T
     Matrix([[t, 0, 0]])
     """
-    sp = _sympy()
+    sp = sympy_module()
     C = taylor_coefficients(order, inertia, pi0, n0)
     t = sp.Symbol("t") if t is None else t
     z = [sum((C[k, a] * t**k for k in range(C.rows)), sp.Integer(0)) for a in range(6)]

@@ -75,7 +75,7 @@ def _taylor():
     w = np.array([[1.0, 0.1, 0.5]] * K.LANES_MIN_BODIES)
     integrate_principal(m[:1], w[:1], _t(), lanes=False)  # one body after the other
     integrate_principal(m, w, _t(), lanes=True)  # SIMD lanes
-    return [K._nb_integrate, K._nb_integrate_lanes]
+    return [K.nb_integrate, K.nb_integrate_lanes]
 
 
 def _taylor_torque():
@@ -95,7 +95,7 @@ def _symplectic():
 
     for scheme in ("splitting", "gauss2", "gauss4", "gauss6"):  # Gauss: one specialization per number of stages
         solve([1.0, 2.0, 3.0], _t(), omega0=[1.0, 0.1, 0.5], method="symplectic", scheme=scheme, workers=1)
-    return [K._nb_splitting, K._nb_gauss]
+    return [K.nb_splitting, K.nb_gauss]
 
 
 def _exact_splitting():
@@ -119,7 +119,7 @@ def _fit():
     from ..estimation import variational as V
 
     V.propagate(np.diag([1.0, 2.0, 3.0]), np.array([1.0, 0.1, 0.5]), np.zeros((2, 3, 3)), _t())
-    return [V._propagate_numba]
+    return [V.propagate_numba]
 
 
 def _plots():
@@ -130,8 +130,8 @@ def _plots():
     q = np.zeros((n, 4))
     q[:, 0] = np.cos(t)
     q[:, 3] = np.sin(t)
-    P._chart_bounds(q, 1.0, 2.0)
-    return list(P._CHART_KERNEL)
+    P.chart_bounds(q, 1.0, 2.0)
+    return list(P.CHART_KERNEL)
 
 
 #: the kernel groups, in the order they are compiled

@@ -1078,7 +1078,7 @@ def chart_segments(q, chart_radius=1.0, *, jump_limit=4.0):
         raise InvalidInputError(f"chart_radius must be positive and finite, got {chart_radius!r}")
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
     conj = np.array([1.0, -1.0, -1.0, -1.0])
-    bounds = _chart_bounds(q, r, float(jump_limit))
+    bounds = chart_bounds(q, r, float(jump_limit))
     if not bounds:
         return []
     # the local vectors of all charts at once: q_ref^-1 q for every sample of every chart
@@ -1165,17 +1165,17 @@ def _chart_bounds_compiled():
     return bounds
 
 
-_CHART_KERNEL: list = []
+CHART_KERNEL: list = []
 
 
-def _chart_bounds(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
+def chart_bounds(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
     """The charts' ``(start, end)``: a numba kernel when numba is used, else :func:`_chart_bounds_numpy`."""
     from ..util.jit import USE_NUMBA
 
     if USE_NUMBA and q.shape[0] > 20_000:  # (short series: not worth the compilation)
-        if not _CHART_KERNEL:
-            _CHART_KERNEL.append(_chart_bounds_compiled())
-        a, b = _CHART_KERNEL[0](np.ascontiguousarray(q), float(r), float(jump_limit))
+        if not CHART_KERNEL:
+            CHART_KERNEL.append(_chart_bounds_compiled())
+        a, b = CHART_KERNEL[0](np.ascontiguousarray(q), float(r), float(jump_limit))
         return list(zip(a.tolist(), b.tolist()))
     return _chart_bounds_numpy(q, r, jump_limit)
 

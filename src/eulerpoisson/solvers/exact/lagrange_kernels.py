@@ -29,46 +29,46 @@ from . import kernels as _K
 __all__ = ["N_LAG", "heavy_top_kernel"]
 
 # per-body constants (columns of C)
-_L_M1 = 0  # 1 - m of the nutation
-_L_M = 1  # 1 - m1 (the parameter as jacobi_sncndn forms it)
-_L_K = 2  # K(m) (inf on the separatrix)
-_L_NU = 3
-_L_TAU0 = 4
-_L_SD = 5  # sqrt(d/2)
-_L_D = 6
-_L_W1 = 7
-_L_W2 = 8
-_L_S1 = 9  # 1.0 where W1 == 0 (signed amplitude cos(theta/2) = sd sn)
-_L_S2 = 10
-_L_Z1 = 11  # 1.0 where the rate of sigma has no 1/(1+u) term
-_L_Z2 = 12
-_L_LAM = 13
-_L_KAPS = 14
-_L_KAPD = 15
-_L_NS = 16
-_L_N1S = 17
-_L_PICS = 18
-_L_SHS = 19  # 1.0: the sigma integral in its shifted form
-_L_ND = 20
-_L_N1D = 21
-_L_PICD = 22
-_L_CSLIN = 23  # dsig = CSLIN ts + CSPER (perS - perS0)
-_L_CSPER = 24
-_L_CDPER = 25  # ddel = -lam ts + CDPER (perD - perD0)
-_L_PERS0 = 26
-_L_PERD0 = 27
-_L_E1R = 28
-_L_E1I = 29
-_L_E2R = 30
-_L_E2I = 31
-_L_SDNU = 32  # sd nu
-_L_DNU = 33  # d nu
-_L_W = 34  # time scale (power of two)
+L_M1 = 0  # 1 - m of the nutation
+L_M = 1  # 1 - m1 (the parameter as jacobi_sncndn forms it)
+L_K = 2  # K(m) (inf on the separatrix)
+L_NU = 3
+L_TAU0 = 4
+L_SD = 5  # sqrt(d/2)
+L_D = 6
+L_W1 = 7
+L_W2 = 8
+L_S1 = 9  # 1.0 where W1 == 0 (signed amplitude cos(theta/2) = sd sn)
+L_S2 = 10
+L_Z1 = 11  # 1.0 where the rate of sigma has no 1/(1+u) term
+L_Z2 = 12
+L_LAM = 13
+L_KAPS = 14
+L_KAPD = 15
+L_NS = 16
+L_N1S = 17
+L_PICS = 18
+L_SHS = 19  # 1.0: the sigma integral in its shifted form
+L_ND = 20
+L_N1D = 21
+L_PICD = 22
+L_CSLIN = 23  # dsig = CSLIN ts + CSPER (perS - perS0)
+L_CSPER = 24
+L_CDPER = 25  # ddel = -lam ts + CDPER (perD - perD0)
+L_PERS0 = 26
+L_PERD0 = 27
+L_E1R = 28
+L_E1I = 29
+L_E2R = 30
+L_E2I = 31
+L_SDNU = 32  # sd nu
+L_DNU = 33  # d nu
+L_W = 34  # time scale (power of two)
 #: number of per-body constants
 N_LAG = 35
 
-_RF_QFAC = _K._RF_QFAC
-_MAX_DUPLICATION = _K._MAX_DUPLICATION
+_RF_QFAC = _K.RF_QFAC
+_MAX_DUPLICATION = _K.MAX_DUPLICATION
 
 
 def _rf2(xa, ya, za, xb, yb, zb):
@@ -84,9 +84,9 @@ def _rf2(xa, ya, za, xb, yb, zb):
     for _ in range(_MAX_DUPLICATION):
         if run_a:
             if fa * qa >= abs(A_a):
-                sx = _K._sqrt(x_a)
-                sy = _K._sqrt(y_a)
-                sz = _K._sqrt(z_a)
+                sx = _K.fast_sqrt(x_a)
+                sy = _K.fast_sqrt(y_a)
+                sz = _K.fast_sqrt(z_a)
                 lam = sx * sy + sy * sz + sz * sx
                 A_a = 0.25 * (A_a + lam)
                 fa = 0.25 * fa
@@ -97,9 +97,9 @@ def _rf2(xa, ya, za, xb, yb, zb):
                 run_a = False
         if run_b:
             if fb * qb >= abs(A_b):
-                sx = _K._sqrt(x_b)
-                sy = _K._sqrt(y_b)
-                sz = _K._sqrt(z_b)
+                sx = _K.fast_sqrt(x_b)
+                sy = _K.fast_sqrt(y_b)
+                sz = _K.fast_sqrt(z_b)
                 lam = sx * sy + sy * sz + sz * sx
                 A_b = 0.25 * (A_b + lam)
                 fb = 0.25 * fb
@@ -110,7 +110,7 @@ def _rf2(xa, ya, za, xb, yb, zb):
                 run_b = False
         if not (run_a or run_b):
             break
-    return _K._rf_poly(a0a, xa, ya, A_a, fa), _K._rf_poly(a0b, xb, yb, A_b, fb)
+    return _K.rf_poly(a0a, xa, ya, A_a, fa), _K.rf_poly(a0b, xb, yb, A_b, fb)
 
 
 def _reduced_args(n, n1, shifted, sn, cn, dn, m1):
@@ -149,7 +149,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
 
     ``lagrange._heavy_top`` and the last steps of ``lagrange.lagrange_top_motion``:
     ``C`` (n, N_LAG) holds the constants of the bodies, ``t`` (T,) the times
-    (each body scales them by its ``_L_W``); the motion in the frame whose
+    (each body scales them by its ``L_W``); the motion in the frame whose
     third axis is up is turned back by ``QF`` (n, 4), normalised, ``Omega_3``
     is the conserved input value ``OM0[:, 2]`` and ``t = 0`` returns the
     inputs ``Q0`` (n, 4) and ``OM0`` (n, 3) exactly.  Returns the number of
@@ -160,47 +160,47 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
     T = t.shape[0]
     cst = np.zeros(_K.N_CONST)
     for b in range(n_b):
-        m1 = C[b, _L_M1]
-        m = C[b, _L_M]
-        cst[_K._C_SEP] = 1.0 if m1 == 0.0 else 0.0
-        cst[_K._C_M] = m
-        cst[_K._C_M1] = m1
-        _K._params(m, m1, 1.0, 1.0, 1.0, False, cst)
-        K = C[b, _L_K]
+        m1 = C[b, L_M1]
+        m = C[b, L_M]
+        cst[_K.C_SEP] = 1.0 if m1 == 0.0 else 0.0
+        cst[_K.C_M] = m
+        cst[_K.C_M1] = m1
+        _K.params(m, m1, 1.0, 1.0, 1.0, False, cst)
+        K = C[b, L_K]
         finite = math.isfinite(K)
         Ks = K if finite else 1.0
-        nu = C[b, _L_NU]
-        tau0 = C[b, _L_TAU0]
-        sd = C[b, _L_SD]
-        d = C[b, _L_D]
-        W1 = C[b, _L_W1]
-        W2 = C[b, _L_W2]
-        s1 = C[b, _L_S1] != 0.0
-        s2 = C[b, _L_S2] != 0.0
-        z1 = C[b, _L_Z1] != 0.0
-        z2 = C[b, _L_Z2] != 0.0
-        lam = C[b, _L_LAM]
-        kaps = C[b, _L_KAPS]
-        kapd = C[b, _L_KAPD]
-        nS = C[b, _L_NS]
-        n1S = C[b, _L_N1S]
-        picS = C[b, _L_PICS]
-        shS = C[b, _L_SHS] != 0.0
-        nD = C[b, _L_ND]
-        n1D = C[b, _L_N1D]
-        picD = C[b, _L_PICD]
-        cslin = C[b, _L_CSLIN]
-        csper = C[b, _L_CSPER]
-        cdper = C[b, _L_CDPER]
-        perS0 = C[b, _L_PERS0]
-        perD0 = C[b, _L_PERD0]
-        e1r = C[b, _L_E1R]
-        e1i = C[b, _L_E1I]
-        e2r = C[b, _L_E2R]
-        e2i = C[b, _L_E2I]
-        sdnu = C[b, _L_SDNU]
-        dnu = C[b, _L_DNU]
-        W = C[b, _L_W]
+        nu = C[b, L_NU]
+        tau0 = C[b, L_TAU0]
+        sd = C[b, L_SD]
+        d = C[b, L_D]
+        W1 = C[b, L_W1]
+        W2 = C[b, L_W2]
+        s1 = C[b, L_S1] != 0.0
+        s2 = C[b, L_S2] != 0.0
+        z1 = C[b, L_Z1] != 0.0
+        z2 = C[b, L_Z2] != 0.0
+        lam = C[b, L_LAM]
+        kaps = C[b, L_KAPS]
+        kapd = C[b, L_KAPD]
+        nS = C[b, L_NS]
+        n1S = C[b, L_N1S]
+        picS = C[b, L_PICS]
+        shS = C[b, L_SHS] != 0.0
+        nD = C[b, L_ND]
+        n1D = C[b, L_N1D]
+        picD = C[b, L_PICD]
+        cslin = C[b, L_CSLIN]
+        csper = C[b, L_CSPER]
+        cdper = C[b, L_CDPER]
+        perS0 = C[b, L_PERS0]
+        perD0 = C[b, L_PERD0]
+        e1r = C[b, L_E1R]
+        e1i = C[b, L_E1I]
+        e2r = C[b, L_E2R]
+        e2i = C[b, L_E2I]
+        sdnu = C[b, L_SDNU]
+        dnu = C[b, L_DNU]
+        W = C[b, L_W]
         for jt in range(T):
             ts = W * t[jt]
             tau = tau0 + nu * ts
@@ -233,7 +233,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
                 _m,
                 _n,
                 _o,
-            ) = _K._sncndn3(k, tau, 0.0, tr, 0.0, abs(tr), 0.0, cst)
+            ) = _K.sncndn3(k, tau, 0.0, tr, 0.0, abs(tr), 0.0, cst)
             if not shS:
                 snS, cnS, dnS = snD, cnD, dnD
             # amplitudes cos(theta/2), sin(theta/2) and their rates
@@ -241,13 +241,13 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
                 cc = sd * sn
                 cdot = sdnu * cn * dn
             else:
-                cc = _K._sqrt(0.5 * (W1 + d * sn * sn))
+                cc = _K.fast_sqrt(0.5 * (W1 + d * sn * sn))
                 cdot = dnu * sn * cn * dn / (2.0 * cc)
             if s2:
                 ss = sd * cn
                 sdot = -sdnu * sn * dn
             else:
-                ss = _K._sqrt(0.5 * (W2 + d * cn * cn))
+                ss = _K.fast_sqrt(0.5 * (W2 + d * cn * cn))
                 sdot = -dnu * sn * cn * dn / (2.0 * ss)
             if not math.isfinite(cdot):
                 cdot = 0.0
@@ -259,7 +259,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
             sS, s2S, c2S, d2S, pS = _reduced_args(nS, n1S, shS, snS, cnS, dnS, m1)
             sD, s2D, c2D, d2D, pD = _reduced_args(nD, n1D, False, snD, cnD, dnD, m1)
             rfS, rfD = _rf2(c2S, d2S, 1.0, c2D, d2D, 1.0)
-            rjS, rjD, _r = _K._rj3(c2S, d2S, 1.0, pS, True, c2D, d2D, 1.0, pD, True, 0.0, 0.0, 0.0, 0.0, False)
+            rjS, rjD, _r = _K.rj3(c2S, d2S, 1.0, pS, True, c2D, d2D, 1.0, pD, True, 0.0, 0.0, 0.0, 0.0, False)
             perS = _periodic(nS, sS, s2S, rfS, rjS, tr, jj, finite, picS, shS)
             perD = _periodic(nD, sD, s2D, rfD, rjD, tr, jj, finite, picD, False)
             dsig = cslin * ts + csper * (perS - perS0)
@@ -295,8 +295,8 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
                 wout[b, jt, 2] = OM0[b, 2]
                 continue
             # back to the frame of the input: conj(q_f) q, then normalised
-            qw, qx, qy, qz = _K._qmul(QF[b, 0], -QF[b, 1], -QF[b, 2], -QF[b, 3], w, x, y, z)
-            nq = _K._sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+            qw, qx, qy, qz = _K.qmul(QF[b, 0], -QF[b, 1], -QF[b, 2], -QF[b, 3], w, x, y, z)
+            nq = _K.fast_sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
             qout[b, jt, 0] = qw / nq
             qout[b, jt, 1] = qx / nq
             qout[b, jt, 2] = qy / nq

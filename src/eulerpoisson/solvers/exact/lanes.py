@@ -87,76 +87,76 @@ _JAC_IN = 3 * _NJAC
 _JAC_W = 10 * _NJAC
 _PRE_SIZE = 34 * _L
 
-_C_SEP = _K._C_SEP
-_C_REGIME = _K._C_REGIME
-_C_EM = _K._C_EM
-_C_ESCALE = _K._C_ESCALE
-_C_M0S = _K._C_M0S
-_SEPARATRIX = _K._SEPARATRIX
-_REGIME_A = _K._REGIME_A
-_REGIME_B = _K._REGIME_B
-_C_CASEB = _K._C_CASEB
-_C_M = _K._C_M
-_C_M1 = _K._C_M1
-_C_KP = _K._C_KP
-_C_KH = _K._C_KH
-_C_KL = _K._C_KL
-_C_PH = _K._C_PH
-_C_PCORR = _K._C_PCORR
-_C_LAM = _K._C_LAM
-_C_T0H = _K._C_T0H
-_C_T0L = _K._C_T0L
-_C_AC = _K._C_AC
-_C_A2 = _K._C_A2
-_C_AA = _K._C_AA
-_C_SA = _K._C_SA
-_C_SC = _K._C_SC
-_C_RATE = _K._C_RATE
-_C_COEF = _K._C_COEF
-_C_NU = _K._C_NU
-_C_OMNU = _K._C_OMNU
-_C_JC = _K._C_JC
-_C_NADD = _K._C_NADD
-_C_CADD = _K._C_CADD
-_C_NUD = _K._C_NUD
-_C_OMNUD = _K._C_OMNUD
-_C_JCD = _K._C_JCD
-_C_G0 = _K._C_G0
-_C_TSCALE = _K._C_TSCALE
-_C_SN0 = _K._C_SN0
-_C_JFAR0 = _K._C_JFAR0
-_C_THETA0 = _K._C_THETA0
-_C_KFULL = _K._C_KFULL
-_C_Q0W = _K._C_Q0W
-_C_Q0X = _K._C_Q0X
-_C_Q0Y = _K._C_Q0Y
-_C_Q0Z = _K._C_Q0Z
-_C_PERM0 = _K._C_PERM0
-_C_SGN0 = _K._C_SGN0
-_C_NLEV = _K._C_NLEV
-_C_MSCALE = _K._C_MSCALE
-_C_TAU0V = _K._C_TAU0V
-_C_HAVE_JC = _K._C_HAVE_JC
-_C_HAVE_JCD = _K._C_HAVE_JCD
-_C_HAVE_JFAR0 = _K._C_HAVE_JFAR0
-_C_HAVE_T0 = _K._C_HAVE_T0
-_C_SQM = _K._C_SQM
-_C_PCL = _K._C_PCL
+_C_SEP = _K.C_SEP
+_C_REGIME = _K.C_REGIME
+_C_EM = _K.C_EM
+_C_ESCALE = _K.C_ESCALE
+_C_M0S = _K.C_M0S
+_SEPARATRIX = _K.SEPARATRIX
+_REGIME_A = _K.REGIME_A
+_REGIME_B = _K.REGIME_B
+_C_CASEB = _K.C_CASEB
+_C_M = _K.C_M
+_C_M1 = _K.C_M1
+_C_KP = _K.C_KP
+_C_KH = _K.C_KH
+_C_KL = _K.C_KL
+_C_PH = _K.C_PH
+_C_PCORR = _K.C_PCORR
+_C_LAM = _K.C_LAM
+_C_T0H = _K.C_T0H
+_C_T0L = _K.C_T0L
+_C_AC = _K.C_AC
+_C_A2 = _K.C_A2
+_C_AA = _K.C_AA
+_C_SA = _K.C_SA
+_C_SC = _K.C_SC
+_C_RATE = _K.C_RATE
+_C_COEF = _K.C_COEF
+_C_NU = _K.C_NU
+_C_OMNU = _K.C_OMNU
+_C_JC = _K.C_JC
+_C_NADD = _K.C_NADD
+_C_CADD = _K.C_CADD
+_C_NUD = _K.C_NUD
+_C_OMNUD = _K.C_OMNUD
+_C_JCD = _K.C_JCD
+_C_G0 = _K.C_G0
+_C_TSCALE = _K.C_TSCALE
+_C_SN0 = _K.C_SN0
+_C_JFAR0 = _K.C_JFAR0
+_C_THETA0 = _K.C_THETA0
+_C_KFULL = _K.C_KFULL
+_C_Q0W = _K.C_Q0W
+_C_Q0X = _K.C_Q0X
+_C_Q0Y = _K.C_Q0Y
+_C_Q0Z = _K.C_Q0Z
+_C_PERM0 = _K.C_PERM0
+_C_SGN0 = _K.C_SGN0
+_C_NLEV = _K.C_NLEV
+_C_MSCALE = _K.C_MSCALE
+_C_TAU0V = _K.C_TAU0V
+_C_HAVE_JC = _K.C_HAVE_JC
+_C_HAVE_JCD = _K.C_HAVE_JCD
+_C_HAVE_JFAR0 = _K.C_HAVE_JFAR0
+_C_HAVE_T0 = _K.C_HAVE_T0
+_C_SQM = _K.C_SQM
+_C_PCL = _K.C_PCL
 _MAX_LANDEN = _K.MAX_LANDEN
-_MAX_AGM = _K._MAX_AGM
-_MAX_DUPLICATION = _K._MAX_DUPLICATION
-_LANDEN_THRESHOLD = _K._LANDEN_THRESHOLD
-_RF_QFAC = _K._RF_QFAC
-_RDJ_QFAC = _K._RDJ_QFAC
-_RC_SERIES_MAX = _K._RC_SERIES_MAX
-_SINCOS_POLY_MAX = _K._SINCOS_POLY_MAX
-_TWO200 = _K._TWO200
-_TWOM100 = _K._TWOM100
-_TWOM104 = _K._TWOM104
-_PI_HI = _K._PI_HI
-_PI_LO = _K._PI_LO
-_PIO2_HI = _K._PIO2_HI
-_PIO2_LO = _K._PIO2_LO
+_MAX_AGM = _K.MAX_AGM
+_MAX_DUPLICATION = _K.MAX_DUPLICATION
+_LANDEN_THRESHOLD = _K.LANDEN_THRESHOLD
+_RF_QFAC = _K.RF_QFAC
+_RDJ_QFAC = _K.RDJ_QFAC
+_RC_SERIES_MAX = _K.RC_SERIES_MAX
+_SINCOS_POLY_MAX = _K.SINCOS_POLY_MAX
+_TWO200 = _K.TWO200
+_TWOM100 = _K.TWOM100
+_TWOM104 = _K.TWOM104
+_PI_HI = _K.PI_HI
+_PI_LO = _K.PI_LO
+_PIO2_HI = _K.PIO2_HI
+_PIO2_LO = _K.PIO2_LO
 _TINY_DELTA = 2.0**-960
 #: rows of CL copied by _jacobi_lanes
 _JAC_ROWS = (_C_SEP, _C_KH, _C_KL, _C_PH, _C_PCORR, _C_M, _C_M1, _C_KP, _C_NLEV)
@@ -166,7 +166,7 @@ _JAC_ROWS = (_C_SEP, _C_KH, _C_KL, _C_PH, _C_PCORR, _C_M, _C_M1, _C_KP, _C_NLEV)
 # Carlson's R_J for a list of jobs
 # =============================================================================
 def _rj_jobs(X, Y, Z, P, R, n):
-    """``R[j] = R_J(X[j], Y[j], Z[j], P[j])`` for ``j < n`` (``kernels._rj3``, one job per slot).
+    """``R[j] = R_J(X[j], Y[j], Z[j], P[j])`` for ``j < n`` (``kernels.rj3``, one job per slot).
 
     The slots run the duplication in lockstep, each with its own stopping
     rule; the ``R_C`` term of a step is the series (vector code) unless
@@ -214,7 +214,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
         y[j] = y0
         z[j] = z0
         p[j] = p0
-        # kernels._rj_init without the rescaling of a tiny delta (below)
+        # kernels.rj_init without the rescaling of a tiny delta (below)
         a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0
         A0[j] = a0
         A[j] = a0
@@ -225,17 +225,17 @@ def _rj_jobs(X, Y, Z, P, R, n):
         q[j] = _RDJ_QFAC * max(max(abs(a0 - x0), abs(a0 - y0)), max(abs(a0 - z0), abs(a0 - p0)))
     for j in range(n):
         if abs(dl[j]) < _TINY_DELTA:
-            a0, delta, s_, q_ = _K._rj_init(X0[j], Y0[j], Z0[j], p[j])
+            a0, delta, s_, q_ = _K.rj_init(X0[j], Y0[j], Z0[j], p[j])
             dl[j] = delta
             sc[j] = s_
     for _ in range(_MAX_DUPLICATION):
         for j in range(n):
             f = F[j]
             RUN[j] = 1.0 if f * q[j] >= abs(A[j]) else 0.0
-            sx = _K._sqrt(x[j])
-            sy = _K._sqrt(y[j])
-            sz = _K._sqrt(z[j])
-            sp = _K._sqrt(p[j])
+            sx = _K.fast_sqrt(x[j])
+            sy = _K.fast_sqrt(y[j])
+            sz = _K.fast_sqrt(z[j])
+            sp = _K.fast_sqrt(p[j])
             lam = sx * sy + sy * sz + sz * sx
             d = (sp + sx) * (sp + sy) * (sp + sz)
             dd = d * sc[j]
@@ -244,7 +244,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
             D[j] = d
             SP[j] = sp
             LM[j] = lam
-            RC[j] = _K._rc1_series(e)
+            RC[j] = _K.rc1_series(e)
         # integer counts (vector code): running slots, and those whose R_C term needs the closed form
         nrun = 0
         nbig = 0
@@ -257,7 +257,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
         if nbig > 0:
             for j in range(n):
                 if RUN[j] != 0.0 and not (abs(E[j]) <= _RC_SERIES_MAX):
-                    RC[j] = _K._rc1(E[j], SP[j], p[j], LM[j], D[j])
+                    RC[j] = _K.rc1(E[j], SP[j], p[j], LM[j], D[j])
         for j in range(n):
             r = RUN[j] != 0.0
             lam = LM[j]
@@ -270,7 +270,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
             z[j] = 0.25 * (z[j] + lam) if r else z[j]
             p[j] = 0.25 * (p[j] + lam) if r else p[j]
     for j in range(n):
-        E[j] = _K._rj_finish(A0[j], X0[j], Y0[j], Z0[j], A[j], F[j], acc[j])
+        E[j] = _K.rj_finish(A0[j], X0[j], Y0[j], Z0[j], A[j], F[j], acc[j])
     for j in range(n):
         R[j] = E[j]
 
@@ -279,7 +279,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
 # Jacobi elliptic functions, one argument per lane and group
 # =============================================================================
 def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
-    """Jacobi functions of the double-double arguments ``UH + UL`` (``kernels._sncndn3``).
+    """Jacobi functions of the double-double arguments ``UH + UL`` (``kernels.sncndn3``).
 
     Slot ``j = g * LANES + l`` (group ``g < ng``, lane ``l < nl``) holds an
     argument of lane ``l``, whose constants are in ``CL``;
@@ -319,7 +319,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         for l in range(nl):
             j = o + l
             sep = LC[l] != 0.0
-            n, r, neg, v, vn, dv = _K._reduce(
+            n, r, neg, v, vn, dv = _K.reduce(
                 IN[j], IN[_NJAC + j], sep, LC[_L + l], LC[2 * _L + l], LC[3 * _L + l], LC[4 * _L + l]
             )
             W[j] = n
@@ -340,9 +340,9 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
             # the real path's starting values by the polynomials (kernels._real_start), vector code
             # for every slot; the other paths overwrite them below
             vn = W[3 * _NJAC + j]
-            W[6 * _NJAC + j] = _K._sin_poly(vn)
-            W[7 * _NJAC + j] = _K._cos_poly(vn)
-            W[8 * _NJAC + j] = _K._sin_poly(0.5 * vn)
+            W[6 * _NJAC + j] = _K.sin_poly(vn)
+            W[7 * _NJAC + j] = _K.cos_poly(vn)
+            W[8 * _NJAC + j] = _K.sin_poly(0.5 * vn)
     for g in range(ng):
         o = g * _L
         for l in range(nl):
@@ -364,7 +364,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                 # the separatrix (kernels._finish): tanh, sech of |r|
                 v = W[9 * _NJAC + j]
                 W[6 * _NJAC + j] = math.tanh(v)
-                W[7 * _NJAC + j] = _K._sech(v)
+                W[7 * _NJAC + j] = _K.sech_real(v)
                 W[8 * _NJAC + j] = 0.0
             else:
                 W[6 * _NJAC + j] = 0.0
@@ -395,7 +395,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                     ok = (W[5 * _NJAC + j] == 1.0) & (fi < LC[8 * _L + l]) & (sq > 0.0)
                     s0 = W[6 * _NJAC + j]
                     c0 = W[7 * _NJAC + j]
-                    s1, c1 = _K._imag_level(s0, c0, sq)
+                    s1, c1 = _K.imag_level(s0, c0, sq)
                     W[6 * _NJAC + j] = s1 if ok else s0
                     W[7 * _NJAC + j] = c1 if ok else c0
         if any_real:
@@ -408,7 +408,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                     s0 = W[6 * _NJAC + j]
                     c0 = W[7 * _NJAC + j]
                     y0 = W[8 * _NJAC + j]
-                    s1, c1, y1 = _K._real_level(s0, c0, y0, sq, LV[(_MAX_LANDEN + i) * _L + l])
+                    s1, c1, y1 = _K.real_level(s0, c0, y0, sq, LV[(_MAX_LANDEN + i) * _L + l])
                     W[6 * _NJAC + j] = s1 if ok else s0
                     W[7 * _NJAC + j] = c1 if ok else c0
                     W[8 * _NJAC + j] = y1 if ok else y0
@@ -423,9 +423,9 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
             Y0 = W[8 * _NJAC + j]
             sv = S0 / C0 if im else S0
             cv = 1.0 / C0 if im else (C0 if sp else (1.0 - Y0 if Y0 < 0.5 else C0))
-            dn_ = _K._dn(sv, cv, LC[5 * _L + l], LC[6 * _L + l])
+            dn_ = _K.dn_from_sc(sv, cv, LC[5 * _L + l], LC[6 * _L + l])
             dv = cv if sp else dn_
-            a, b, e, f, h, kk, u, w = _K._quadrant(
+            a, b, e, f, h, kk, u, w = _K.quadrant(
                 W[j], W[_NJAC + j], W[2 * _NJAC + j] != 0.0, sv, cv, dv, LC[7 * _L + l]
             )
             OL[j] = a
@@ -497,8 +497,8 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             TS[l] = math.ldexp(TT[l], int(CL[_C_ESCALE * _L + l]))
     for l in range(nl):
         ts = TS[l]
-        dh, dl = _K._two_prod(lam_r[l], ts)
-        th, tl = _K._dd_add(dh, dl, t0h_r[l], t0l_r[l])
+        dh, dl = _K.two_prod(lam_r[l], ts)
+        th, tl = _K.dd_add(dh, dl, t0h_r[l], t0l_r[l])
         DH[l] = dh
         DLo[l] = dl
         UH[l] = th
@@ -545,11 +545,11 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         if GF[l] >= 0.0:
             j = int(GF[l])
             CL[_C_SN0 * _L + l] = O[j]
-            CL[_C_THETA0 * _L + l] = _K._theta_v(ac, kp, a2, O[3 * _NJAC + j], O[5 * _NJAC + j], O[6 * _NJAC + j])
+            CL[_C_THETA0 * _L + l] = _K.theta_v(ac, kp, a2, O[3 * _NJAC + j], O[5 * _NJAC + j], O[6 * _NJAC + j])
             for k in range(5):
                 CL[(_C_TAU0V + k) * _L + l] = O[(3 + k) * _NJAC + j]
             CL[_C_HAVE_T0 * _L + l] = 1.0
-        THETA[l] = _K._theta_v(ac, kp, a2, O[3 * _NJAC + l], O[5 * _NJAC + l], O[6 * _NJAC + l])
+        THETA[l] = _K.theta_v(ac, kp, a2, O[3 * _NJAC + l], O[5 * _NJAC + l], O[6 * _NJAC + l])
     # --- round one of R_J: far lanes (tau, tau0 on the first far evaluation, J_c), J_c of near lanes.
     # The arguments of kernels._far for every lane in vector code (AUX rows: odd, S, S2, C2, D2, p at
     # tau, then at tau0), the list of jobs lane by lane, the integrals from the R_J in vector code.
@@ -560,10 +560,10 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         kp = CL[_C_KP * _L + l]
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
-        odd, S, S2, C2, D2, p = _K._jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l], O[7 * _NJAC + l], kp)
+        odd, S, S2, C2, D2, p = _K.jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l], O[7 * _NJAC + l], kp)
         n0 = CL[_C_TAU0V * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        odd0, S0, S20, C20, D20, p0 = _K._jtot_args(
+        odd0, S0, S20, C20, D20, p0 = _K.jtot_args(
             nu, omnu, neff0, CL[(_C_TAU0V + 2) * _L + l], CL[(_C_TAU0V + 3) * _L + l], CL[(_C_TAU0V + 4) * _L + l], kp
         )
         AUX[l] = 1.0 if odd else 0.0
@@ -627,12 +627,12 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         jc = CL[_C_JC * _L + l]
         n0 = CL[_C_TAU0V * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        j0 = _K._jtot_from(
+        j0 = _K.jtot_from(
             AUX[6 * _L + l] != 0.0, neff0, CL[(_C_TAU0V + 1) * _L + l], jc, AUX[7 * _L + l], AUX[8 * _L + l], R0[l]
         )
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
-        jj = _K._jtot_from(AUX[l] != 0.0, neff, O[4 * _NJAC + l], jc, AUX[_L + l], AUX[2 * _L + l], RT[l])
+        jj = _K.jtot_from(AUX[l] != 0.0, neff, O[4 * _NJAC + l], jc, AUX[_L + l], AUX[2 * _L + l], RT[l])
         R0[l] = m1 * j0 if caseB else j0
         RT[l] = m1 * jj if caseB else jj
     for l in range(nl):
@@ -652,7 +652,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 continue
             j = int(GN[l])
             N = CL[_C_NADD * _L + l]
-            XADD[l] = _K._near_xadd(
+            XADD[l] = _K.near_xadd(
                 N, CL[_C_CADD * _L + l], O[l] * CL[_C_SN0 * _L + l], O[j], O[_NJAC + j], O[2 * _NJAC + j]
             )
             dlt = DH[l] + DLo[l]
@@ -670,7 +670,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 nu = CL[_C_NUD * _L + l]
                 omnu = CL[_C_OMNUD * _L + l]
                 nx = n
-            odd, S, S2, C2, D2, p = _K._jtot_args(
+            odd, S, S2, C2, D2, p = _K.jtot_args(
                 nu, omnu, nx, O[5 * _NJAC + j], O[6 * _NJAC + j], O[7 * _NJAC + j], CL[_C_KP * _L + l]
             )
             AUX[l] = 1.0 if odd else 0.0
@@ -715,10 +715,10 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 else:
                     jc = CL[_C_JC * _L + l]
             rj = JR[int(IT[l])] if IT[l] >= 0.0 else 0.0
-            jd = _K._jtot_from(AUX[l] != 0.0, nx, O[4 * _NJAC + j], jc, AUX[_L + l], AUX[2 * _L + l], rj)
+            jd = _K.jtot_from(AUX[l] != 0.0, nx, O[4 * _NJAC + j], jc, AUX[_L + l], AUX[2 * _L + l], rj)
             dlt = DH[l] + DLo[l]
             if CL[_C_SEP * _L + l] != 0.0:
-                jd = _K._jsep(CL[_C_NADD * _L + l], dlt)
+                jd = _K.jsep(CL[_C_NADD * _L + l], dlt)
             g0 = CL[_C_G0 * _L + l]
             if caseB:
                 if use_sh:
@@ -794,10 +794,10 @@ def _attitude_lanes(CL, O, ON, CA, SAL, OUT, nl):
         sal = IN[16 * _L + l]
         ex = 0.0 if caseB else sa * sal
         ez = sa * sal if caseB else 0.0
-        tw, tx, ty, tz = _K._qmin(M1, M2, M3, caseB, sa)
-        uw, ux, uy, uz = _K._qmul(IN[15 * _L + l], ex, 0.0, ez, tw, tx, ty, tz)
-        qw, qx, qy, qz = _K._qmul(IN[6 * _L + l], -IN[7 * _L + l], -IN[8 * _L + l], -IN[9 * _L + l], uw, ux, uy, uz)
-        nq = _K._sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        tw, tx, ty, tz = _K.qmin(M1, M2, M3, caseB, sa)
+        uw, ux, uy, uz = _K.qmul(IN[15 * _L + l], ex, 0.0, ez, tw, tx, ty, tz)
+        qw, qx, qy, qz = _K.qmul(IN[6 * _L + l], -IN[7 * _L + l], -IN[8 * _L + l], -IN[9 * _L + l], uw, ux, uy, uz)
+        nq = _K.fast_sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
         fM = IN[10 * _L + l]
         s1 = IN[11 * _L + l]
         # sorted frame, with the sign of the permutation on the middle axis (1.0 * x keeps the bits)
@@ -849,20 +849,20 @@ def _initial(CL, l, OUT):
     a0 = 0 if p0 == 0.0 else (1 if p1 == 0.0 else 2)
     a1 = 0 if p0 == 1.0 else (1 if p1 == 1.0 else 2)
     a2 = 0 if p0 == 2.0 else (1 if p1 == 2.0 else 2)
-    OUT[l] = _K._pick3(a0, Ms0, Ms1, Ms2)
-    OUT[_L + l] = _K._pick3(a1, Ms0, Ms1, Ms2)
-    OUT[2 * _L + l] = _K._pick3(a2, Ms0, Ms1, Ms2)
+    OUT[l] = _K.pick3(a0, Ms0, Ms1, Ms2)
+    OUT[_L + l] = _K.pick3(a1, Ms0, Ms1, Ms2)
+    OUT[2 * _L + l] = _K.pick3(a2, Ms0, Ms1, Ms2)
     OUT[3 * _L + l] = 1.0
-    OUT[4 * _L + l] = _K._pick3(a0, qs0, qs1, qs2)
-    OUT[5 * _L + l] = _K._pick3(a1, qs0, qs1, qs2)
-    OUT[6 * _L + l] = _K._pick3(a2, qs0, qs1, qs2)
+    OUT[4 * _L + l] = _K.pick3(a0, qs0, qs1, qs2)
+    OUT[5 * _L + l] = _K.pick3(a1, qs0, qs1, qs2)
+    OUT[6 * _L + l] = _K.pick3(a2, qs0, qs1, qs2)
 
 
 # =============================================================================
 # per-body set-up of the lanes
 # =============================================================================
 def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
-    """``kernels._params`` of lanes ``l < nl`` at once: AGM, Landen chain, ``R_F`` (into ``CL``; ``R_F`` into ``PRF``)."""
+    """``kernels.params`` of lanes ``l < nl`` at once: AGM, Landen chain, ``R_F`` (into ``CL``; ``R_F`` into ``PRF``)."""
     m_ = stack_buffer(_L)
     m1_ = stack_buffer(_L)
     rx_ = stack_buffer(_L)
@@ -899,9 +899,9 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
     for l in range(nl):
         m = m_[l]
         m1 = m1_[l]
-        kp = _K._sqrt(m1)
+        kp = _K.fast_sqrt(m1)
         sep = m1 == 0.0
-        bh, bl = _K._dd_sqrt_f(m1 * _TWO200, 0.0)
+        bh, bl = _K.dd_sqrt_f(m1 * _TWO200, 0.0)
         AH[l] = 1.0
         AL[l] = 0.0
         BH[l] = 0.0 if sep else bh * _TWOM100
@@ -928,16 +928,16 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
     for it in range(_MAX_DUPLICATION):
         agm_it = it < _MAX_AGM
         for l in range(nl):
-            # AGM for K in double-double (kernels._params)
+            # AGM for K in double-double (kernels.params)
             ah = AH[l]
             al = AL[l]
             bh = BH[l]
             bl = BL[l]
-            dh, _dl = _K._dd_add(ah, al, -bh, -bl)
+            dh, _dl = _K.dd_add(ah, al, -bh, -bl)
             go = agm_it & (AGM[l] != 0.0) & (abs(dh) > _TWOM104 * ah)
-            sh, sl = _K._dd_add(ah, al, bh, bl)
-            ph, pl = _K._dd_mul_f(ah, al, bh, bl)
-            nbh, nbl = _K._dd_sqrt_f(ph, pl)
+            sh, sl = _K.dd_add(ah, al, bh, bl)
+            ph, pl = _K.dd_mul_f(ah, al, bh, bl)
+            nbh, nbl = _K.dd_sqrt_f(ph, pl)
             AH[l] = 0.5 * sh if go else ah
             AL[l] = 0.5 * sl if go else al
             BH[l] = nbh if go else bh
@@ -950,9 +950,9 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
             x = X[l]
             y = Y[l]
             z = Z[l]
-            sx = _K._sqrt(x)
-            sy = _K._sqrt(y)
-            sz = _K._sqrt(z)
+            sx = _K.fast_sqrt(x)
+            sy = _K.fast_sqrt(y)
+            sz = _K.fast_sqrt(z)
             lam = sx * sy + sy * sz + sz * sx
             RA[l] = 0.25 * (ra + lam) if ron else ra
             RFAC[l] = 0.25 * rfac if ron else rfac
@@ -968,7 +968,7 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
                 pc = PC[l]
                 pc1 = PC1[l]
                 lon = (LAN[l] != 0.0) & (pc > THR[l])
-                kq = _K._sqrt(pc1)
+                kq = _K.fast_sqrt(pc1)
                 den = (1.0 + kq) * (1.0 + kq)
                 sq = pc / den
                 pn1 = 4.0 * kq / den
@@ -993,7 +993,7 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
             maxlev = nlv
     for l in range(nl):
         sep = m1_[l] == 0.0
-        kh, kl = _K._dd_div_f(_PI_HI, _PI_LO, AH[l], AL[l])
+        kh, kl = _K.dd_div_f(_PI_HI, _PI_LO, AH[l], AL[l])
         KH[l] = _PIO2_HI if sep else 0.5 * kh
         KL[l] = _PIO2_LO if sep else 0.5 * kl
         PPH[l] = 1.0
@@ -1003,25 +1003,25 @@ def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
         sq_r = CL[(_C_SQM + i) * _L : (_C_SQM + i + 1) * _L]
         for l in range(nl):
             ok = fi < NLEV[l]
-            oh, ol = _K._two_sum(1.0, sq_r[l])
-            ph, pl = _K._dd_mul(PPH[l], PPL[l], oh, ol)
+            oh, ol = _K.two_sum(1.0, sq_r[l])
+            ph, pl = _K.dd_mul(PPH[l], PPL[l], oh, ol)
             PPH[l] = ph if ok else PPH[l]
             PPL[l] = pl if ok else PPL[l]
     for l in range(nl):
-        CL[_C_KP * _L + l] = _K._sqrt(m1_[l])
+        CL[_C_KP * _L + l] = _K.fast_sqrt(m1_[l])
         CL[_C_KH * _L + l] = KH[l]
         CL[_C_KL * _L + l] = KL[l]
         CL[_C_PH * _L + l] = PPH[l]
         CL[_C_PCORR * _L + l] = PPL[l] / PPH[l]
         CL[_C_NLEV * _L + l] = NLEV[l]
-        PRF[l] = _K._rf_poly(RA0[l], rx_[l], ry_[l], RA[l], RFAC[l]) if do_[l] != 0.0 else 0.0
+        PRF[l] = _K.rf_poly(RA0[l], rx_[l], ry_[l], RA[l], RFAC[l]) if do_[l] != 0.0 else 0.0
 
 
 def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
     """``kernels.body_setup`` of bodies ``b0 .. b0 + nl - 1`` into lanes ``0 .. nl - 1`` (``EQ[l]``: relative equilibrium).
 
-    ``kernels._setup_pre`` in vector code (sorting, scaling, regime and constants of all lanes at
-    once; ``hypot`` lane by lane), :func:`_params_lanes`, then ``kernels._setup_post`` lane by lane.
+    ``kernels.setup_pre`` in vector code (sorting, scaling, regime and constants of all lanes at
+    once; ``hypot`` lane by lane), :func:`_params_lanes`, then ``kernels.setup_post`` lane by lane.
     Relative equilibria and bodies whose scale factors are not normal numbers are set up by the
     scalar code (the same values).  Lanes ``nl ..`` get a copy of lane 0.
     """
@@ -1046,23 +1046,23 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
         m0 = M0[b, 0]
         m1_ = M0[b, 1]
         m2 = M0[b, 2]
-        p0, p1, p2, s1 = _K._perm3(i0, i1, i2)
-        I1u = _K._pick3(p0, i0, i1, i2)
-        I2u = _K._pick3(p1, i0, i1, i2)
-        I3u = _K._pick3(p2, i0, i1, i2)
-        M1u = 1.0 * _K._pick3(p0, m0, m1_, m2)
-        M2u = s1 * _K._pick3(p1, m0, m1_, m2)
-        M3u = 1.0 * _K._pick3(p2, m0, m1_, m2)
+        p0, p1, p2, s1 = _K.perm3(i0, i1, i2)
+        I1u = _K.pick3(p0, i0, i1, i2)
+        I2u = _K.pick3(p1, i0, i1, i2)
+        I3u = _K.pick3(p2, i0, i1, i2)
+        M1u = 1.0 * _K.pick3(p0, m0, m1_, m2)
+        M2u = s1 * _K.pick3(p1, m0, m1_, m2)
+        M3u = 1.0 * _K.pick3(p2, m0, m1_, m2)
         mmax = max(max(abs(M1u), abs(M2u)), abs(M3u))
-        eMx, okM = _K._exponent_lane(mmax)
-        eI, okI = _K._exponent_lane(I3u)
+        eMx, okM = _K.exponent_lane(mmax)
+        eI, okI = _K.exponent_lane(I3u)
         eM = 0 if mmax == 0.0 else eMx
-        fM = _K._pow2(-eM)
-        fI = _K._pow2(-eI)
+        fM = _K.pow2(-eM)
+        fI = _K.pow2(-eI)
         M1 = M1u * fM
         M2 = M2u * fM
         M3 = M3u * fM
-        eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _K._pre_regime(
+        eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _K.pre_regime(
             M1, M2, M3, I1u * fI, I2u * fI, I3u * fI
         )
         scalar = eq | ((mmax != 0.0) & (not okM)) | (not okI) | (fM == 0.0) | (fI == 0.0)
@@ -1076,8 +1076,8 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
         PRE[7 * _L + l] = M3u
         PRE[8 * _L + l] = eM
         PRE[9 * _L + l] = eM - eI
-        PRE[10 * _L + l] = _K._pow2(eM)
-        PRE[11 * _L + l] = _K._pow2(eM - eI)
+        PRE[10 * _L + l] = _K.pow2(eM)
+        PRE[11 * _L + l] = _K.pow2(eM - eI)
         PRE[12 * _L + l] = M1
         PRE[13 * _L + l] = M2
         PRE[14 * _L + l] = M3
@@ -1106,7 +1106,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
     for l in range(nl):
         m = PRE[15 * _L + l]
         m1 = PRE[16 * _L + l]
-        c0, s0, delta2 = _K._pre_amplitude(H[l], PRE[32 * _L + l], PRE[33 * _L + l], m, m1)
+        c0, s0, delta2 = _K.pre_amplitude(H[l], PRE[32 * _L + l], PRE[33 * _L + l], m, m1)
         EQ[l] = 0.0
         PM[l] = m
         PM1[l] = m1
@@ -1119,7 +1119,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
         PMb[l] = PRE[13 * _L + l]
         PMc[l] = PRE[14 * _L + l]
     for l in range(nl):
-        # kernels._setup_pre's stores (kernels._pre_store), all lanes
+        # kernels.setup_pre's stores (kernels._pre_store), all lanes
         sep = PRE[17 * _L + l] != 0.0
         caseB = PRE[18 * _L + l] != 0.0
         CL[_C_PERM0 * _L + l] = PRE[_L + l]
@@ -1164,7 +1164,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
         if PRE[l] != 0.0:
             # relative equilibria, scale factors that are not normal numbers: the scalar code
             b = b0 + l
-            eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = _K._setup_pre(
+            eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = _K.setup_pre(
                 inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], CL[l::_L]
             )
             EQ[l] = 1.0 if eq else 0.0
@@ -1189,7 +1189,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
     _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl)
     for l in range(nl):
         if EQ[l] == 0.0:
-            _K._setup_post(CL[l::_L], PRF[l], PC0[l], PS0[l], PMa[l], PMb[l], PMc[l])
+            _K.setup_post(CL[l::_L], PRF[l], PC0[l], PS0[l], PMa[l], PMb[l], PMc[l])
         else:
             # a relative equilibrium is evaluated by the caller; its lane computes along with neutral values
             for k in (_C_AC, _C_A2, _C_AA, _C_SA, _C_SC, _C_Q0W, _C_MSCALE, _C_TSCALE, _C_LAM, _C_KFULL, _C_M, _C_M1):

@@ -336,7 +336,7 @@ def _nb_rotate_axis(buf, axis, tau):
         _nb_rotate(buf, tau, _SM2, _SM0, _SM1, _SI2, _SZ, _SX, _SY)
 
 
-def _nb_splitting(q0, M0, inv_m, axes, fracs, seg_h, seg_n, seg_out, seg_restart, q_out, w_out):
+def nb_splitting(q0, M0, inv_m, axes, fracs, seg_h, seg_n, seg_out, seg_restart, q_out, w_out):
     B = q0.shape[1]
     K = axes.shape[0]
     nseg = seg_h.shape[0]
@@ -597,7 +597,7 @@ def _nb_gauss_advance(buf, h, N, A, b, E, max_iter, status):
     return True
 
 
-def _nb_gauss(y0, inv_m, A, b, E, max_iter, seg_h, seg_n, seg_out, seg_restart, q_out, w_out, iters, status):
+def nb_gauss(y0, inv_m, A, b, E, max_iter, seg_h, seg_n, seg_out, seg_restart, q_out, w_out, iters, status):
     B = y0.shape[1]
     L = _LG
     nseg = seg_h.shape[0]
@@ -661,8 +661,8 @@ if USE_NUMBA:  # pragma: no branch
     _nb_gauss_finish = _plain(_nb_gauss_finish)
     _nb_gauss_advance = _plain(_nb_gauss_advance)
     _nb_sincos_array = _njit(cache=True, nogil=True)(_nb_sincos_array)
-    _nb_splitting = _njit(cache=True, nogil=True)(_nb_splitting)
-    _nb_gauss = _njit(cache=True, nogil=True)(_nb_gauss)
+    nb_splitting = _njit(cache=True, nogil=True)(nb_splitting)
+    nb_gauss = _njit(cache=True, nogil=True)(nb_gauss)
 
 
 # ---------------------------------------------------------------------------
@@ -706,7 +706,7 @@ def run_splitting(q0, M0, inv_m, sequence, t, dt):
     fracs = np.array([f for _, f in sequence], dtype=np.float64)
     q_out = np.empty((B, T, 4))
     w_out = np.empty((B, T, 3))
-    _nb_splitting(
+    nb_splitting(
         np.ascontiguousarray(q0, dtype=np.float64),
         np.ascontiguousarray(M0, dtype=np.float64),
         np.ascontiguousarray(inv_m, dtype=np.float64),
@@ -757,7 +757,7 @@ def run_gauss_quaternion(y0, inv_m, tableau, t, dt, max_iter):
     w_out = np.empty((B, T, 3))
     iters = np.zeros((B, 2), dtype=np.int64)
     status = np.zeros(4)
-    _nb_gauss(
+    nb_gauss(
         np.ascontiguousarray(y0, dtype=np.float64),
         np.ascontiguousarray(inv_m, dtype=np.float64),
         A,

@@ -638,7 +638,7 @@ def _nb_horner_delta(N, W, order, theta, n, w):
     w[2] = _nb_mul(b2, theta)
 
 
-def _nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold, q_out, w_out, stats):
+def nb_integrate(moments, w0, qref0, t, idx_pos, idx_neg, tol, order, dt, max_steps, threshold, q_out, w_out, stats):
     B = moments.shape[0]
     N = np.zeros((order + 1, 3))
     W = np.zeros((order + 1, 3))
@@ -907,7 +907,7 @@ def _nb_lane_horner_delta(buf, l, order, theta):
     )
 
 
-def _nb_integrate_lanes(
+def nb_integrate_lanes(
     moments,
     w0,
     qref0,
@@ -927,7 +927,7 @@ def _nb_integrate_lanes(
     lane_i,
     lane_f,
 ):
-    """:func:`_nb_integrate` with ``_TL`` bodies in lockstep, one per lane.
+    """:func:`nb_integrate` with ``_TL`` bodies in lockstep, one per lane.
 
     Every lane runs the scalar kernel's algorithm on its own body (its own
     steps, outputs and chart changes); when a body is done the lane takes
@@ -1198,10 +1198,10 @@ if USE_NUMBA:  # pragma: no branch
     _nb_horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner)
     _nb_horner_delta = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_horner_delta)
     _nb_coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_coefficients)
-    _nb_integrate = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate)
+    nb_integrate = _njit(cache=True, nogil=True, fastmath={"contract"})(nb_integrate)
     _nb_series_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_series_lanes)
     _nb_lane_horner_delta = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_lane_horner_delta)
-    _nb_integrate_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(_nb_integrate_lanes)
+    nb_integrate_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(nb_integrate_lanes)
 
 
 def coefficients_numba(moments, n0, w0, order):
@@ -1260,7 +1260,7 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     if lanes is None:
         lanes = USE_NUMBA and B >= LANES_MIN_BODIES
     if lanes:
-        _nb_integrate_lanes(
+        nb_integrate_lanes(
             *args,
             np.zeros((int(order) + 1) * _TR),
             np.zeros(3 * _TL),
@@ -1268,5 +1268,5 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
             np.zeros(3 * _TL),
         )
     else:
-        _nb_integrate(*args)
+        nb_integrate(*args)
     return q_out, w_out, stats

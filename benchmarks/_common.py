@@ -286,31 +286,45 @@ class HeyokaPeer:
         return q, st[4:].copy()
 
 
+def _heyoka_batch(hy, omega0, tol: float):
+    """heyoka's batch (SIMD) integrator for the bodies ``omega0`` (B, 3), compiled, and a ``reset(ta, g)``
+    that puts the ``g``-th group of ``recommended_simd_size()`` bodies at t = 0 (identity attitude).
+
+    Returns ``(ta, reset, batch_size, groups)``; bodies beyond the last whole group are left out.
+    """
+    bs = int(hy.recommended_simd_size())
+    groups = omega0.shape[0] // bs
+    ic = np.zeros((7, bs))
+    ic[0] = 1.0
+    ic[4:] = omega0[:bs].T
+    ta = hy.taylor_adaptive_batch(heyoka_system(hy), ic, tol=tol)
+
+    def reset(tb, g):
+        tb.set_time(0.0)
+        st = tb.state
+        st[:4] = 0.0
+        st[0] = 1.0
+        st[4:] = omega0[g * bs : (g + 1) * bs].T
+        return tb
+
+    return ta, reset, bs, groups
+
+
 def heyoka_batch_throughput(hy, omega0, t_end: float, *, tol: float = EPS):
     """Body-seconds per second of heyoka's batch (SIMD) mode over the bodies ``omega0`` (B, 3).
 
     Batches of ``recommended_simd_size()`` bodies; each batch is reset and propagated to
     ``t_end``. Compilation is not timed. Returns (body_seconds_per_second, batch_size, wall).
     """
-    bs = int(hy.recommended_simd_size())
-    B = omega0.shape[0] - omega0.shape[0] % bs
-    ic = np.zeros((7, bs))
-    ic[0] = 1.0
-    ic[4:] = omega0[:bs].T
-    ta = hy.taylor_adaptive_batch(heyoka_system(hy), ic, tol=tol)
+    ta, reset, bs, groups = _heyoka_batch(hy, omega0, tol)
 
     def run():
-        for b0 in range(0, B, bs):
-            ta.set_time(0.0)
-            st = ta.state
-            st[:4] = 0.0
-            st[0] = 1.0
-            st[4:] = omega0[b0 : b0 + bs].T
-            ta.propagate_until(float(t_end))
+        for g in range(groups):
+            reset(ta, g).propagate_until(float(t_end))
         return ta.state.copy()
 
     wall, _, _ = best_time(run, repeats=3, budget=3.0)
-    return B * t_end / wall, bs, wall, B
+    return groups * bs * t_end / wall, bs, wall, groups * bs
 
 
 def heyoka_ensemble(hy, omega0, t_end: float, workers: int, *, tol: float = EPS, per_thread: bool = False):
@@ -327,21 +341,8 @@ def heyoka_ensemble(hy, omega0, t_end: float, workers: int, *, tol: float = EPS,
     from concurrent.futures import ThreadPoolExecutor
     from copy import deepcopy
 
-    bs = int(hy.recommended_simd_size())
-    B = omega0.shape[0] - omega0.shape[0] % bs
-    groups = B // bs
-    ic = np.zeros((7, bs))
-    ic[0] = 1.0
-    ic[4:] = omega0[:bs].T
-    ta = hy.taylor_adaptive_batch(heyoka_system(hy), ic, tol=tol)
-
-    def reset(tb, g):
-        tb.set_time(0.0)
-        st = tb.state
-        st[:4] = 0.0
-        st[0] = 1.0
-        st[4:] = omega0[g * bs : (g + 1) * bs].T
-        return tb
+    ta, reset, bs, groups = _heyoka_batch(hy, omega0, tol)
+    B = groups * bs
 
     if not per_thread:
 

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _markers import needs_numba
 from eulerpoisson.cli import main
 from eulerpoisson.solvers import get_method, parallel
 from eulerpoisson.solvers.problem import make_problem
@@ -31,7 +32,6 @@ from eulerpoisson.util import jit
 
 EXE = str(Path(sys.executable).with_name("eulerpoisson"))
 HEAVY = ("numba", "scipy.linalg", "xarray", "dask", "matplotlib", "sympy")
-needs_numba = pytest.mark.skipif(not jit.USE_NUMBA, reason="numba not installed or EULERPOISSON_NO_NUMBA=1")
 
 
 def _default_env(**extra) -> dict:

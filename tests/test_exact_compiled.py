@@ -34,8 +34,8 @@ import sys
 import textwrap
 
 import numpy as np
-import pytest
 
+from _markers import needs_numba
 from eulerpoisson.solvers.exact import kernels as K
 from eulerpoisson.solvers.exact.motion import (
     _exact_constants_compiled,
@@ -47,8 +47,6 @@ from eulerpoisson.solvers.exact.motion import (
 )
 
 EPS = np.finfo(np.float64).eps
-
-needs_numba = pytest.mark.skipif(not K.USE_NUMBA, reason="numba not installed or disabled")
 
 
 # ---------------------------------------------------------------------------

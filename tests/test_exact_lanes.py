@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from _markers import needs_numba
 from eulerpoisson.solvers.exact import kernels as K
 from eulerpoisson.solvers.exact import lagrange as LG
 from eulerpoisson.solvers.exact import lanes as LN
@@ -30,8 +31,6 @@ from test_exact_compiled import _cases, _switch_times, _times
 from test_lagrange_top import CASES, SEPARATRIX, T_CHECK
 
 EPS = np.finfo(np.float64).eps
-
-needs_numba = pytest.mark.skipif(not K.USE_NUMBA, reason="numba not installed or disabled")
 
 
 def _run(kern, inertia, M0, t):

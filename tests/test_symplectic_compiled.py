@@ -16,12 +16,11 @@ import textwrap
 import numpy as np
 import pytest
 
+from _markers import needs_numba
 from eulerpoisson import EulerPoissonError
 from eulerpoisson.solvers import charts as ch
 from eulerpoisson.solvers import solve
 from eulerpoisson.solvers.symplectic import kernels as K
-
-numba_only = pytest.mark.skipif(not K.USE_NUMBA, reason="numba not installed or EULERPOISSON_NO_NUMBA=1")
 
 I3 = np.array([1.0, 2.0, 3.0])
 W0 = np.array([1.0, 0.3, 0.6])
@@ -139,7 +138,7 @@ def test_schedule_is_the_steps_of_run_fixed_step(t, dt):
 # ---------------------------------------------------------------------------
 # compiled == NumPy, bit for bit
 # ---------------------------------------------------------------------------
-@numba_only
+@needs_numba
 @pytest.mark.parametrize("scheme", COMPILED_SCHEMES)
 @pytest.mark.parametrize("body", ["diagonal", "full"])
 def test_compiled_equals_numpy_bitwise(scheme, body, rng, monkeypatch):
@@ -158,7 +157,7 @@ def test_compiled_equals_numpy_bitwise(scheme, body, rng, monkeypatch):
         assert fast.stats.get(key) == slow.stats.get(key), key
 
 
-@numba_only
+@needs_numba
 @pytest.mark.parametrize("scheme", COMPILED_SCHEMES)
 def test_each_body_of_a_batch_as_if_alone(scheme, rng):
     """Lockstep lanes: a body's result does not depend on its neighbours (bit for bit)."""
@@ -219,7 +218,7 @@ def test_no_numba_subprocess_matches(tmp_path):
 # ---------------------------------------------------------------------------
 # edge cases
 # ---------------------------------------------------------------------------
-@numba_only
+@needs_numba
 @pytest.mark.parametrize(
     "opts",
     [
@@ -242,7 +241,7 @@ def test_failures_same_as_numpy(opts, monkeypatch):
     assert "reduce dt" in str(fast.value)
 
 
-@numba_only
+@needs_numba
 def test_giant_splitting_steps_use_libm(monkeypatch):
     """Rotation angles beyond 2**19 rad (0.5 h Omega_i up to 3e6): the libm branch; still exact rotations."""
     w0 = np.array([[1.0, 0.3, 0.6], [2.0, -1.0, 0.5], [0.001, 0.002, 0.0]])
@@ -259,7 +258,7 @@ def test_giant_splitting_steps_use_libm(monkeypatch):
     np.testing.assert_allclose(fast.m, (I3 * w0)[:, None, :].repeat(2, 1), rtol=0, atol=1e-13)
 
 
-@numba_only
+@needs_numba
 @pytest.mark.parametrize("scheme", ["splitting4", "gauss4"])
 def test_large_batch_keeps_integrals(scheme, rng):
     """500 bodies x 2000 steps of 0.1 rad: m conserved to round-off, the energy error O(h^4)."""

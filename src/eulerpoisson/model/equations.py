@@ -71,6 +71,12 @@ def _dot(a, b):
     return np.einsum("...i,...i->...", a, b)
 
 
+def _dot3(a, b):
+    """``a . b`` over the last axis (length 3) as an explicit sum of three products: no reduction whose
+    order could depend on the batch, so an element of a batch gives the bits it gives alone."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
 class LagrangeTop(NamedTuple):
     r"""A heavy symmetric top with its centre of mass on the symmetry axis, in its own frame.
 
@@ -332,8 +338,7 @@ class Model:
         grav = self.torques[0]
         shape = tuple(self.batch_shape)
         c = np.broadcast_to(np.asarray(grav.center_of_mass, dtype=float), shape + (3,))
-        c0, c1, c2 = c[..., 0], c[..., 1], c[..., 2]
-        cn = np.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
+        cn = np.sqrt(_dot3(c, c))
         if np.any(cn == 0.0):
             return None
         ev = np.broadcast_to(self.body.principal_moments, shape + (3,))
@@ -341,16 +346,11 @@ class Model:
         inertia = np.broadcast_to(self.body.inertia, shape + (3, 3))
         tol = SYMMETRY_RTOL * np.max(ev, axis=-1)
         chat = c / cn[..., None]
-        # explicit sums of three terms: no reduction whose order could depend on the batch
-        Ic = (
-            inertia[..., 0] * chat[..., 0, None]
-            + inertia[..., 1] * chat[..., 1, None]
-            + inertia[..., 2] * chat[..., 2, None]
-        )
-        C = chat[..., 0] * Ic[..., 0] + chat[..., 1] * Ic[..., 1] + chat[..., 2] * Ic[..., 2]
+        Ic = _dot3(inertia, chat[..., None, :])
+        C = _dot3(chat, Ic)
         d = Ic - C[..., None] * chat
         # the centre of mass must lie on an eigenvector whose eigenvalue is simple or the body a sphere,
-        if np.any(np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2 + d[..., 2] ** 2) > tol):
+        if np.any(np.sqrt(_dot3(d, d)) > tol):
             return None
         # and the other two moments (the eigenvalue C removed once) must be equal
         k = np.argmin(np.abs(ev - C[..., None]), axis=-1)
@@ -364,12 +364,8 @@ class Model:
         from_axes = np.take_along_axis(P, j[..., None, None], axis=-1)[..., 0]
         from_eye = np.eye(3)[np.argmin(np.abs(chat), axis=-1)]
         trial = np.where((np.ptp(ev, axis=-1) > tol)[..., None], from_axes, from_eye)
-        e1 = (
-            trial
-            - (trial[..., 0] * chat[..., 0] + trial[..., 1] * chat[..., 1] + trial[..., 2] * chat[..., 2])[..., None]
-            * chat
-        )
-        e1 = e1 / np.sqrt(e1[..., 0] ** 2 + e1[..., 1] ** 2 + e1[..., 2] ** 2)[..., None]
+        e1 = trial - _dot3(trial, chat)[..., None] * chat
+        e1 = e1 / np.sqrt(_dot3(e1, e1))[..., None]
         e2 = np.cross(chat, e1)
         F = np.stack([e1, e2, chat], axis=-1)
         mass = np.array(np.broadcast_to(np.asarray(grav.mass, dtype=float), shape))

@@ -417,6 +417,14 @@ def rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
 # parameter set-up: K (AGM in double-double), Landen chain and the R_F of the
 # initial phase, interleaved
 # =============================================================================
+
+
+def rj1(x, y, z, p):
+    """One ``R_J(x, y, z, p)`` by :func:`rj3` (its other two jobs off): the same operations as a job of three."""
+    r, _, _ = rj3(x, y, z, p, True, 0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False)
+    return r
+
+
 def params(m, m1, rx, ry, rz, do_rf, cst):
     """Parameter data of the Jacobi kernels into ``cst``; returns ``R_F(rx, ry, rz)``.
 
@@ -793,7 +801,7 @@ def _jtot(nu, omnu, jc, n, r, s, c, d, kp):
     at ``r`` (``motion._jtot`` for one element, not on the separatrix)."""
     odd, S, S2, C2, D2, p = jtot_args(nu, omnu, n, s, c, d, kp)
     if S2 > 0.0:
-        rj, _, _ = rj3(C2, D2, 1.0, p, True, 0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False)
+        rj = rj1(C2, D2, 1.0, p)
     else:
         rj = 0.0
     return jtot_from(odd, n, r, jc, S, S2, rj)
@@ -805,23 +813,7 @@ def _get_jc(cst):
         if cst[C_SEP] != 0.0:
             cst[C_JC] = 0.0
         else:
-            rj, _, _ = rj3(
-                0.0,
-                cst[C_M1],
-                1.0,
-                cst[C_OMNU],
-                True,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                False,
-                0.0,
-                0.0,
-                0.0,
-                0.0,
-                False,
-            )
+            rj = rj1(0.0, cst[C_M1], 1.0, cst[C_OMNU])
             cst[C_JC] = rj / 3.0
         cst[C_HAVE_JC] = 1.0
     return cst[C_JC]
@@ -832,23 +824,7 @@ def _get_jcd(cst):
     if cst[C_CASEB] == 0.0:
         return _get_jc(cst)
     if cst[C_HAVE_JCD] == 0.0:
-        rj, _, _ = rj3(
-            0.0,
-            cst[C_M1],
-            1.0,
-            cst[C_OMNUD],
-            True,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            False,
-            0.0,
-            0.0,
-            0.0,
-            0.0,
-            False,
-        )
+        rj = rj1(0.0, cst[C_M1], 1.0, cst[C_OMNUD])
         cst[C_JCD] = rj / 3.0
         cst[C_HAVE_JCD] = 1.0
     return cst[C_JCD]
@@ -1601,6 +1577,7 @@ if USE_NUMBA:  # pragma: no branch
     _rj_step = _jiti(_rj_step)
     rj_finish = _jiti(rj_finish)
     rj3 = _jit(rj3)
+    rj1 = _jiti(rj1)
     params = _jit(params)
     sech_real = _jiti(sech_real)
     reduce = _jiti(reduce)

@@ -245,7 +245,7 @@ class Exact(Method):
         )
         _check_phase_range(problem, rate)
         compiled = self._use_compiled(problem)
-        if np.all(F.reshape(-1, 9) == np.eye(3).reshape(9)):
+        if _all_identity(F):
             # the symmetry axis is the third body axis already: no change of frame
             q, w = lagrange_top_motion(A, C, mass, ell, g, problem.q0, problem.omega0, problem.t, compiled=compiled)
         else:
@@ -272,13 +272,14 @@ def _numba_in_use() -> bool:
     return USE_NUMBA
 
 
+def _all_identity(frames) -> bool:
+    """Whether every 3x3 matrix of ``frames`` (shape ``(..., 3, 3)``) is the identity, exactly."""
+    return bool(np.all(np.reshape(frames, (-1, 9)) == np.eye(3).reshape(9)))
+
+
 def _principal_frame(problem: Problem) -> bool:
     """Whether every principal frame of the batch is the body frame (``principal_axes`` the identity)."""
-    P = np.asarray(problem.body.principal_axes)
-    eye = np.eye(3)
-    if P.ndim == 2:
-        return bool(np.array_equal(P, eye))
-    return bool(np.all(P.reshape(-1, 9) == eye.reshape(9)))
+    return _all_identity(problem.body.principal_axes)
 
 
 def _lagrange_parameters(model):

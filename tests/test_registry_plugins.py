@@ -32,4 +32,4 @@ def test_register_solve_and_unregister():
 def test_unregister_unknown_names_fail(name):
     with pytest.raises(InvalidInputError, match="unknown method"):
         unregister_method(name)
-    assert ep.available_methods() == ["exact", "rk", "symplectic", "taylor"]
+    assert ep.available_methods() == ["exact", "rk", "rk4", "symplectic", "taylor"]

@@ -334,7 +334,7 @@ def available_methods() -> list[str]:
     --------
     >>> import eulerpoisson as ep
     >>> ep.available_methods()
-    ['exact', 'rk', 'symplectic', 'taylor']
+    ['exact', 'rk', 'rk4', 'symplectic', 'taylor']
     """
     return sorted(_REGISTRY)
 
@@ -347,9 +347,9 @@ def methods_supporting(model: Model) -> list[str]:
     >>> import eulerpoisson as ep
     >>> from eulerpoisson.solvers import methods_supporting
     >>> methods_supporting(ep.Model([1.0, 2.0, 2.5]))
-    ['exact', 'rk', 'symplectic', 'taylor']
+    ['exact', 'rk', 'rk4', 'symplectic', 'taylor']
     >>> methods_supporting(ep.Model([1.0, 2.0, 2.5], lambda t, q, omega: -0.1 * omega))
-    ['rk']
+    ['rk', 'rk4']
     """
     return sorted(name for name, cls in _REGISTRY.items() if cls.supports(model) is None)
 
@@ -372,7 +372,7 @@ def check_supported(name: str, model: Model) -> None:
     ... except ep.UnsupportedModelError as err:
     ...     print(err)
     method 'exact' cannot run this model: the closed form covers the free body and the Lagrange top ...;
-    methods that can: rk, symplectic, taylor
+    methods that can: rk, rk4, symplectic, taylor
     """
     reason = get_method(name).supports(model)
     if reason is None:

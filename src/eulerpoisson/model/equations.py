@@ -19,7 +19,8 @@ inertia tensor, :class:`~eulerpoisson.RigidBody`) and zero or more torques
   Kovalevskaya integral when :math:`I_1 = I_2 = 2I_3` with the centre of mass
   in the equatorial plane, the Goryachev–Chaplygin integral when
   :math:`I_1 = I_2 = 4I_3` on its level :math:`\mathbf m\cdot\hat{\mathbf g} = 0`;
-  the Jacobi integral for the gravity gradient;
+  the Jacobi integral for the gravity gradient; each torque class states
+  its own (:meth:`eulerpoisson.torques.Torque.integrals`);
 - what a method needs to decide whether it can run the model
   (:attr:`Model.is_free`, :meth:`Model.polynomial`, :meth:`Model.potential`,
   :meth:`Model.lagrange_top`).
@@ -47,20 +48,17 @@ from ..errors import InvalidInputError
 from ..numerics.quaternion import qmul_components
 from .body import RigidBody
 from .torques import (
+    SYMMETRY_RTOL,
     CallableTorque,
     Gravity,
-    GravityGradient,
+    IntegralContext,
     PolynomialTorque,
-    SpaceTorque,
     Torque,
     TorqueLike,
     as_torques,
 )
 
 __all__ = ["Model", "LagrangeTop", "as_model"]
-
-#: relative tolerance for recognizing equal moments and a centre of mass on an axis or plane
-SYMMETRY_RTOL = 1e-12
 
 
 def _mv(A, v):
@@ -283,45 +281,6 @@ class Model:
         E = 0.5 * _dot(omega, _mv(self.body.inertia, omega))
         return E + self.potential(t, q) if self.torques else E
 
-    def _gravity_direction(self):
-        """Common unit direction of g of the model's Gravity torques, or None."""
-        gs = [t for t in self.torques if isinstance(t, Gravity)]
-        if not gs:
-            return None
-        g = gs[0].g
-        n = np.sqrt(_dot(g, g))
-        if np.any(n == 0):
-            return None
-        ghat = g / n[..., None]
-        for other in gs[1:]:
-            n2 = np.sqrt(_dot(other.g, other.g))
-            if np.any(n2 == 0) or not np.allclose(other.g / n2[..., None], ghat, rtol=0, atol=1e-14):
-                return None
-        return ghat
-
-    def _equatorial_top(self, ratio):
-        r"""``(frame, x0y0, kappa)`` when the model is a heavy top with :math:`I = \mathrm{diag}(r, r, 1)I_3` and c in the equatorial plane."""
-        gs = [t for t in self.torques if isinstance(t, Gravity)]
-        if len(gs) != 1 or len(self.torques) != 1 or self.batch_shape:
-            return None
-        grav = gs[0]
-        ev = self.body.principal_moments
-        P = self.body.principal_axes
-        order = np.argsort(ev)
-        small, a, b = ev[order[0]], ev[order[1]], ev[order[2]]
-        if not (abs(a - b) <= SYMMETRY_RTOL * b and abs(a - ratio * small) <= 1e-12 * a):
-            return None
-        e3 = P[:, order[0]]
-        e1 = P[:, order[1]]
-        e2 = np.cross(e3, e1)
-        F = np.stack([e1, e2, e3], axis=1)  # body = F @ frame
-        c = F.T @ grav.center_of_mass
-        if abs(c[2]) > SYMMETRY_RTOL * max(float(np.linalg.norm(c)), 1e-300) or np.linalg.norm(c) == 0:
-            return None
-        gn = float(np.linalg.norm(grav.g))
-        kappa = float(grav.mass) * gn / float(small)
-        return F, c[:2], kappa, grav.g / gn
-
     def lagrange_top(self) -> LagrangeTop | None:
         r"""The model as a :class:`LagrangeTop` (symmetric body, centre of mass on the axis, one Gravity), else None.
 
@@ -404,8 +363,12 @@ class Model:
             :math:`J = \tfrac12\boldsymbol\Omega\cdot I\boldsymbol\Omega
             - \nu\,\hat{\mathbf e}_z\cdot\mathbf m + \tfrac32\nu^2\mathbf r\cdot I\mathbf r`.
             Constant space-frame torques alone: the components of
-            :math:`\mathbf m - \boldsymbol\tau_s t`. Other models: what holds for
-            them (possibly nothing).
+            :math:`\mathbf m - \boldsymbol\tau_s t`. Magnetic dipoles in constant
+            fields alone: ``energy`` and, with parallel fields, ``m_field``
+            (:math:`\mathbf m\cdot\hat{\mathbf B}`). Other models: the ``energy``
+            when every torque is conservative and autonomous, else what holds for
+            them (possibly nothing). Each torque class says what it conserves
+            (:meth:`eulerpoisson.torques.Torque.integrals`).
 
         References
         ----------
@@ -415,11 +378,7 @@ class Model:
         t = np.asarray(t, dtype=float)
         q = np.asarray(q, dtype=float)
         omega = np.asarray(omega, dtype=float)
-
-        def per_body(a, tail):
-            a = np.asarray(a, dtype=float)
-            return a.reshape(a.shape[: a.ndim - tail] + (1,) + a.shape[a.ndim - tail :])
-
+        per_body = IntegralContext.per_body
         inertia = per_body(self.body.inertia, 2)
         # the same expressions as Trajectory.M, .m and .energy (so that the drifts agree to the last bit)
         R = matrix_from_unit_quaternion(q)
@@ -432,54 +391,62 @@ class Model:
             out["m_x"], out["m_y"], out["m_z"] = m[..., 0], m[..., 1], m[..., 2]
             out["m_norm"] = np.sqrt(_dot(m, m))
             return out
+        # what the torques conserve: the hook of their class when they are all of one, else the base rule
         kinds = {type(tq) for tq in self.torques}
-        if kinds == {Gravity}:
-            U = 0.0
-            for tq in cast(tuple[Gravity, ...], self.torques):
-                U = U - _dot(per_body(tq.g, 1), _mv(R, per_body(tq.moment_arm, 1)))
-            out["energy"] = kinetic + U
-            ghat = self._gravity_direction()
-            if ghat is None:
-                return out
-            out["m_vertical"] = _dot(m, per_body(ghat, 1))
-            if self.batch_shape:
-                return out
-            lt = self.lagrange_top()
-            if lt is not None:
-                out["M3"] = _dot(M, lt.frame[:, 2])
-            for ratio, key in ((2.0, "kovalevskaya"), (4.0, "goryachev_chaplygin")):
-                eq = self._equatorial_top(ratio)
-                if eq is None:
-                    continue
-                F, c2, kappa, gh1 = eq
-                w = _mv(F.T, omega)
-                gamma = -_mv(F.T, np.einsum("...ji,j->...i", R, gh1))
-                if key == "kovalevskaya":
-                    val = (w[..., 0] + 1j * w[..., 1]) ** 2 - kappa * (c2[0] + 1j * c2[1]) * (
-                        gamma[..., 0] + 1j * gamma[..., 1]
-                    )
-                    out[key] = (val * np.conj(val)).real
-                else:
-                    area = out["m_vertical"]
-                    scale = float(np.sqrt(np.max(_dot(m, m)))) if m.size else 0.0
-                    if area.size and np.all(np.abs(area[..., 0]) <= 1e-12 * max(scale, 1e-300)):
-                        out[key] = w[..., 2] * (w[..., 0] ** 2 + w[..., 1] ** 2) - kappa * gamma[..., 2] * (
-                            c2[0] * w[..., 0] + c2[1] * w[..., 1]
-                        )
-            return out
-        if kinds == {GravityGradient} and len(self.torques) == 1:
-            nu = per_body(cast(GravityGradient, self.torques[0]).mean_motion, 0)
-            phase = t * nu
-            rhat = np.stack([np.cos(phase), np.sin(phase), np.zeros_like(phase)], -1)
-            r = np.einsum("...ji,...j->...i", R, rhat)
-            out["jacobi"] = kinetic - nu * m[..., 2] + 1.5 * nu**2 * _dot(r, _mv(inertia, r))
-            return out
-        if kinds == {SpaceTorque}:
-            tau = sum(per_body(tq.tau, 1) for tq in cast(tuple[SpaceTorque, ...], self.torques))
-            rest = m - t[:, None] * tau
-            for i, ax in enumerate("xyz"):
-                out[f"m_{ax} - tau_{ax} t"] = rest[..., i]
+        hook = kinds.pop() if len(kinds) == 1 else Torque
+        ctx = IntegralContext(t=t, R=R, omega=omega, M=M, m=m, kinetic=kinetic, inertia=inertia)
+        out.update(hook.integrals(self, self.torques, ctx))
         return out
+
+    # ------------------------------------------------------------------
+    # continuing from a later time
+    # ------------------------------------------------------------------
+    def shifted(self, t_start: float) -> tuple[Model, NDArray[np.float64]]:
+        r"""The model seen from the time ``t_start`` on: ``(model', phi)``.
+
+        With :math:`s = t - t_\mathrm{start}`, the motion under ``model'``
+        from the state at ``t_start`` rotated by :math:`R_z(-\varphi)` is the
+        original motion, rotated by :math:`R_z(-\varphi)` in space. A torque
+        that turns the space frame (:attr:`~eulerpoisson.torques.Torque.frame_rate`,
+        a gravity gradient of mean motion :math:`\nu`: its orbit direction is
+        :math:`\hat{\mathbf r}(t_\mathrm{start} + s) = R_z(\varphi)\hat{\mathbf r}(s)`)
+        sets :math:`\varphi = \nu t_\mathrm{start}` (the first one with a rate not
+        zero); every torque is then shifted by its own
+        :meth:`~eulerpoisson.torques.Torque.shifted` (space-fixed vectors turned by
+        :math:`-\varphi`, a Python function called at the shifted time with the
+        attitude turned back, body-frame torques unchanged).
+
+        Parameters
+        ----------
+        t_start : float
+
+        Returns
+        -------
+        model : Model
+            The same body under the shifted torques.
+        phi : ndarray, shape () or the batch shape of the rate
+            :math:`\varphi` (rad; zero when no torque turns the frame).
+
+        Raises
+        ------
+        InvalidInputError
+            A time-dependent torque of a class that cannot be shifted.
+
+        Examples
+        --------
+        >>> import numpy as np, eulerpoisson as ep
+        >>> model = ep.Model([1.0, 2.0, 2.5], [ep.torques.GravityGradient(0.5), ep.torques.SpaceTorque([1.0, 0.0, 0.0])])
+        >>> later, phi = model.shifted(np.pi)
+        >>> print(phi, np.round(later.torques[1].tau, 12) + 0.0)        # phi = nu t_start; tau turned by -phi
+        1.5707963267948966 [ 0. -1.  0.]
+        """
+        phi = np.zeros(())
+        for tq in self.torques:
+            rate = tq.frame_rate
+            if rate is not None and np.any(rate != 0):
+                phi = np.asarray(rate, dtype=float) * t_start
+                break
+        return Model(self.body, [tq.shifted(t_start, phi) for tq in self.torques]), phi
 
 
 def as_model(body: Model | RigidBody | ArrayLike, torque: TorqueLike = None) -> Model:

@@ -192,7 +192,7 @@ def test_a_file_with_non_unit_quaternions_is_refused(tmp_path):
 
 
 def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
-    from eulerpoisson.cli import commands
+    from eulerpoisson.cli import simulate as commands
 
     monkeypatch.setattr(commands, "LONG_RUN_STEPS", 100)
     t = np.linspace(0.0, 1e4, 5)
@@ -204,7 +204,7 @@ def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
 
 
 def test_a_run_written_nowhere_keeps_its_ends_and_the_same_drift():
-    from eulerpoisson.cli import commands
+    from eulerpoisson.cli import simulate as commands
 
     t = np.linspace(0.0, 50.0, 12001)
     model = ep.Model([1, 2, 3])

@@ -1,5 +1,5 @@
-"""The ``eulerpoisson`` command line (:mod:`.commands`) and the showcase of ``make demo`` (:mod:`.demo`)."""
+"""The ``eulerpoisson`` command line (:mod:`.main`, one module per command) and the showcase of ``make demo`` (:mod:`.demo`)."""
 
-from .commands import main
+from .main import main
 
 __all__ = ["main"]

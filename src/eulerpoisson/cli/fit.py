@@ -13,7 +13,7 @@ import argparse
 import math
 import os
 
-from .commands import UsageError
+from .common import UsageError
 
 __all__ = ["add_commands", "cmd_fit", "FIT_EXAMPLES"]
 

@@ -13,7 +13,7 @@ import math
 import os
 import sys
 
-from .commands import UsageError, check_file_name, inertia_from
+from .common import UsageError, check_file_name, inertia_from
 
 __all__ = ["add_commands", "cmd_validate", "cmd_cases"]
 

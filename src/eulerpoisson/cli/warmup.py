@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 
-from .commands import UsageError
+from .common import UsageError
 
 __all__ = ["add_commands", "cmd_warmup", "WARMUP_EXAMPLES"]
 

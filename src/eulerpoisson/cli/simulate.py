@@ -1,0 +1,493 @@
+"""The ``eulerpoisson simulate`` command: solve the motion of a body and print or save it."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+from ..attitude.core import UNIT_QUATERNION_TOLERANCE
+from ..errors import EulerPoissonError
+from .common import UsageError, check_file_name, load_toml, naming_target, parse_floats
+from .config import (
+    FLAGS,
+    METHOD_OPTIONS,
+    build_body,
+    build_torques,
+    config_from_toml,
+    method_options,
+    namer,
+    pair,
+)
+
+__all__ = ["add_commands", "cmd_simulate", "MAX_SAMPLES", "CHUNKED_SAMPLES", "LONG_RUN_STEPS", "CHUNKS"]
+
+
+#: most output times of one run (a float64 time axis has 2**53 distinct integers; far beyond any disk)
+MAX_SAMPLES = 10**13
+
+#: bytes per sample and body of an in-memory run: q, omega, their copies in the Trajectory and the derived
+#: quantities written to a file (M, m, energy, Gibbs vector), float64
+_BYTES_PER_SAMPLE = 8 * (4 + 3) * 4 + 8 * (3 + 3 + 1 + 3)
+
+
+def _memory_needed(samples: int, batch_shape) -> float:
+    bodies = int(np.prod(batch_shape)) if batch_shape else 1
+    return float(samples) * bodies * _BYTES_PER_SAMPLE
+
+
+def _memory_available() -> float | None:
+    """Available memory in bytes (None where the system does not say)."""
+    try:
+        return float(os.sysconf("SC_AVPHYS_PAGES")) * float(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        return None
+
+
+def _torque_records(model) -> list[dict]:
+    return [tq.to_dict() for tq in model.torques]
+
+
+def _state_json(traj, drift) -> dict:
+    i = int(np.argmax(np.abs(traj.t)))  # the state at T (T < 0: backwards)
+    q = traj.quaternion[..., i, :]
+    sing = bool(q[0] == 0)
+    return {
+        "t": float(traj.t[i]),
+        "quaternion": q.tolist(),
+        "omega": traj.omega[..., i, :].tolist(),
+        "gibbs": None if sing else (q[1:] / q[0]).tolist(),
+        "m": traj.m[..., i, :].tolist(),
+        "energy": float(traj.energy[..., i]),
+        "method": traj.method,
+        "drift": {k: float(v) for k, v in drift.items()},
+        "torque": _torque_records(traj.model),
+        "integrals": {k: float(v[..., i]) for k, v in traj.integrals().items()},
+    }
+
+
+#: output samples above which ``simulate`` works in chunks (and shows a progress bar on a terminal)
+CHUNKED_SAMPLES = 5000
+
+#: a stepping method expected to take more steps than this runs in chunks with a progress bar, whatever the samples
+LONG_RUN_STEPS = 100_000
+CHUNKS = 50
+
+
+def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: bool = True):
+    """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
+
+    The chunking depends only on the number of samples (never on whether a
+    terminal is attached), so a run gives the same numbers everywhere. The
+    closed form evaluates every chunk from the initial state (identical to one
+    call); stepping methods continue each chunk from the last state of the
+    previous one, as :func:`eulerpoisson.io.stream.solve_to_file` does.
+
+    ``keep=False`` (nothing is written): only the first and the last sample
+    are kept and the drift of the integrals is accumulated chunk by chunk,
+    so memory does not grow with the samples; returns ``(trajectory of those
+    two samples, drift)``.
+    """
+    from ..io.stream import ProgressDisplay, solve_from
+    from ..model.drift import DriftAccumulator
+    from ..solvers import get_method, solve
+    from ..trajectory import Trajectory
+
+    closed_form = get_method(method).order is None
+    long_run = False
+    if not closed_form and omega0 is not None and t.size > 2:
+        # a stepping method turns the body by a few radians per step at most: a long run shows progress too
+        rate = float(np.max(np.linalg.norm(np.atleast_2d(omega0), axis=-1)))
+        long_run = rate * float(np.max(np.abs(t))) / (8 * np.pi) > LONG_RUN_STEPS
+    if t.size < CHUNKED_SAMPLES and not long_run:
+        tr = solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+        return tr if keep else (tr, tr.drift())
+    acc = None if keep else DriftAccumulator(model)
+    pieces = [p for p in np.array_split(np.arange(t.size), min(CHUNKS, t.size)) if p.size]
+    qs: list[np.ndarray] = []
+    ws: list[np.ndarray] = []
+    wall = 0.0
+    first = None
+    qs_end_index = 0  # the last output time of the previous chunk (a stepping method continues from it)
+    from ..util.jit import whole_run
+
+    # one choice of compiled kernels or NumPy for the whole run, not per chunk (the same numbers as one call)
+    with ProgressDisplay(progress, t.size, f"{method}: solving") as bar, whole_run(n_times=t.size):
+        done = 0
+        for idx in pieces:
+            if closed_form or first is None:
+                tr = solve(model, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+            else:
+                # the time-dependent torques are shifted to the chunk's start (solve_from)
+                tr = solve_from(
+                    model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :], method=method, **opts
+                )
+            first = tr if first is None else first
+            if acc is not None:
+                acc.update(tr.t, tr.quaternion, tr.omega)
+                if len(qs) > 1:  # keep the first chunk's first sample and the last chunk only
+                    qs.pop()
+                    ws.pop()
+            qs.append(tr.quaternion if acc is None or not qs else tr.quaternion[..., -1:, :])
+            ws.append(tr.omega if acc is None or not ws else tr.omega[..., -1:, :])
+            qs_end_index = idx[-1]
+            wall += tr.stats.get("wall_time", 0.0)
+            done += idx.size
+            bar.update(done)
+    assert first is not None  # there is at least one piece
+    stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
+    if acc is not None:
+        ends = Trajectory(
+            t[[0, -1]],
+            np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
+            np.concatenate([ws[0][..., :1, :], ws[-1][..., -1:, :]], axis=-2),
+            first.body,
+            method,
+            first.options,
+            stats,
+            torque=list(model.torques),
+        )
+        return ends, acc.result()
+    return Trajectory(
+        t,
+        np.concatenate(qs, axis=-2),
+        np.concatenate(ws, axis=-2),
+        first.body,
+        method,
+        first.options,
+        stats,
+        torque=list(model.torques),
+    )
+
+
+def cmd_simulate(args) -> int:
+    from ..attitude.core import quaternion_from_gibbs
+    from ..model.equations import Model
+    from ..solvers import available_methods
+    from ..solvers.registry import check_supported
+
+    cfg: dict = {}
+    src: dict = {}
+    if args.config is not None:
+        cfg.update(config_from_toml(load_toml(args.config), args.config, src))
+        # a file that contradicts itself is an error even when a flag would replace both values
+        file_name = namer(src)
+        for k1, k2, what in (
+            ("initial.omega", "initial.m", "exactly one of"),
+            ("initial.quaternion", "initial.gibbs", "at most one of"),
+            ("body.inertia", "body.masses", "either"),
+            ("body.inertia", "body.positions", "either"),
+        ):
+            if k1 in cfg and k2 in cfg:
+                pre, a, b = pair(file_name, k1, k2)
+                raise UsageError(f"{pre}give {what} {a} {'or' if what == 'either' else 'and'} {b}, not both")
+    given = {
+        key: getattr(args, attr)
+        for attr, key in (
+            ("inertia", "body.inertia"),
+            ("omega", "initial.omega"),
+            ("m", "initial.m"),
+            ("quaternion", "initial.quaternion"),
+            ("gibbs", "initial.gibbs"),
+            ("t_end", "time.t_end"),
+            ("samples", "time.samples"),
+            ("method", "method.name"),
+            ("allow_unphysical", "body.allow_unphysical"),
+            *((opt, f"method.{opt}") for opt in METHOD_OPTIONS),
+            ("out", "output.file"),
+            ("gravity", "torque.gravity"),
+            ("mass", "torque.mass"),
+            ("com", "torque.center_of_mass"),
+            ("gravity_gradient", "torque.gravity_gradient"),
+            ("body_torque", "torque.body_torque"),
+            ("space_torque", "torque.space_torque"),
+            ("workers", "compute.workers"),
+        )
+        if getattr(args, attr, None) is not None
+    }
+    # two flags that say the same thing differently are an error; a flag replaces what the file says
+    if "initial.omega" in given and "initial.m" in given:
+        raise UsageError(
+            "give exactly one of --omega and --m (the initial body angular velocity or the angular momentum), not both"
+        )
+    if "initial.quaternion" in given and "initial.gibbs" in given:
+        raise UsageError("give at most one of --quaternion and --gibbs (the initial attitude), not both")
+    replaces = {
+        "initial.omega": ("initial.m",),
+        "initial.m": ("initial.omega",),
+        "initial.quaternion": ("initial.gibbs",),
+        "initial.gibbs": ("initial.quaternion",),
+        "body.inertia": ("body.masses", "body.positions"),
+    }
+    for key, v in given.items():
+        for other in replaces.get(key, ()):
+            cfg.pop(other, None)
+            src.pop(other, None)
+        cfg[key] = v
+        src[key] = FLAGS[key]
+    name = namer(src)
+
+    body = build_body(cfg, name)
+    if "initial.omega" in cfg and "initial.m" in cfg:
+        pre, a, b = pair(name, "initial.omega", "initial.m")
+        raise UsageError(f"{pre}give exactly one of {a} and {b}, not both")
+    if "initial.omega" not in cfg and "initial.m" not in cfg:
+        raise UsageError(
+            "give exactly one initial condition: --omega W1,W2,W3 (body angular velocity) or --m (angular momentum)"
+        )
+    omega0 = m0 = None
+    if "initial.omega" in cfg:
+        omega0 = parse_floats(cfg["initial.omega"], name("initial.omega"), (3,))
+    else:
+        m0 = parse_floats(cfg["initial.m"], name("initial.m"), (3,))
+    if "initial.quaternion" in cfg and "initial.gibbs" in cfg:
+        pre, a, b = pair(name, "initial.quaternion", "initial.gibbs")
+        raise UsageError(f"{pre}give at most one of {a} and {b}, not both")
+    q0 = None
+    if "initial.quaternion" in cfg:
+        q0 = np.array(parse_floats(cfg["initial.quaternion"], name("initial.quaternion"), (4,)))
+        nrm = float(np.linalg.norm(q0))
+        if abs(nrm - 1.0) > UNIT_QUATERNION_TOLERANCE:
+            raise UsageError(
+                f"{name('initial.quaternion')} must be a unit quaternion w,x,y,z (norm 1 within {UNIT_QUATERNION_TOLERANCE:g}); its norm is {nrm:.9g}"
+            )
+        q0 = q0 / nrm
+    elif "initial.gibbs" in cfg:
+        q0 = quaternion_from_gibbs(parse_floats(cfg["initial.gibbs"], name("initial.gibbs"), (3,)))
+    if "time.t_end" not in cfg:
+        raise UsageError("give the final time with --t-end T")
+    try:
+        t_end = float(cfg["time.t_end"])
+    except (TypeError, ValueError):
+        raise UsageError(f"{name('time.t_end')}: {cfg['time.t_end']!r} is not a number") from None
+    if not math.isfinite(t_end):
+        raise UsageError(
+            f"{name('time.t_end')} must be a finite number (negative: backwards in time), got {cfg['time.t_end']!r}"
+        )
+    samples = cfg.get("time.samples", 1001)
+    if isinstance(samples, str):
+        try:
+            samples = int(samples.strip())
+        except ValueError:
+            raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples!r}") from None
+    if samples < 2:
+        raise UsageError(f"{name('time.samples')} must be an integer >= 2, got {samples}")
+    if samples > MAX_SAMPLES:
+        raise UsageError(
+            f"{name('time.samples')} = {samples} is more than {MAX_SAMPLES:.3g} output times, which no "
+            f"file or memory holds (a .zarr store of 1e8 samples is about 11 GB)"
+        )
+    out_name = cfg.get("output.file")
+    if not (isinstance(out_name, str) and out_name.endswith(".zarr")):
+        # a run written to NetCDF is held in memory; one written nowhere keeps its ends and the times only
+        need = _memory_needed(samples, body.batch_shape) if out_name is not None else 16.0 * samples
+        free = _memory_available()
+        if free is not None and need > free:
+            raise UsageError(
+                f"{name('time.samples')} = {samples} needs about {need / 2**30:.3g} GiB in memory, more than the "
+                f"{free / 2**30:.3g} GiB available; stream it to disk instead: --out run.zarr"
+            )
+    torques = build_torques(cfg, name)
+    model = Model(body, torques)
+    # the closed form runs the free body (and the Lagrange top); under a torque the default is taylor
+    method = cfg.get("method.name", "exact" if model.is_free else "taylor")
+    if method not in available_methods():
+        raise UsageError(
+            f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}"
+        )
+    check_supported(method, model)  # UnsupportedModelError (one line, exit 2) names the methods that can
+    opts = method_options(cfg, name, method)
+    workers = cfg.get("compute.workers")
+    if workers is not None:
+        try:
+            workers = int(str(workers).strip())
+        except ValueError:
+            workers = 0
+        if workers < 1:
+            raise UsageError(
+                f"{name('compute.workers')} must be a whole number of threads >= 1, got {cfg['compute.workers']!r}"
+            )
+        opts["workers"] = workers  # a keyword of solve, solve_from and solve_to_file, not a method option
+    out = cfg.get("output.file")
+    check_file_name(out, name("output.file"))
+    as_json = bool(args.json or cfg.get("output.json", False))
+    progress = False if (args.quiet or as_json) else None
+    if out is not None and not str(out).endswith((".nc", ".nc4", ".netcdf", ".zarr")):
+        raise UsageError(f"{name('output.file')} {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")
+    if out is not None:
+        # one policy for outputs: nothing replaced without --overwrite, never an input or another kind of file
+        from ..io.outputs import OutputLock, check_output
+
+        zarr_out = str(out).endswith(".zarr")
+        check_output(
+            out, "trajectory-store" if zarr_out else "netcdf", overwrite=bool(args.overwrite), inputs=[args.config]
+        )
+    if out is not None and str(out).endswith(".zarr"):
+        # long runs stream to disk chunk by chunk (atomic, resumable); the state at T is read back from the file
+        from ..io.stream import partial_store, solve_to_file
+
+        if partial_store(out).exists() and not args.overwrite and not args.quiet and not as_json:
+            print(
+                f"resuming the interrupted run to {out} from its finished chunks (--overwrite starts afresh)",
+                file=sys.stderr,
+            )
+        start = time.perf_counter()
+        with OutputLock(out), naming_target(out):
+            try:
+                solve_to_file(
+                    model,
+                    (0.0, t_end, samples),
+                    out,
+                    omega0=omega0,
+                    m0=m0,
+                    attitude0=q0,
+                    method=method,
+                    progress=progress,
+                    resume=not args.overwrite,
+                    overwrite=bool(args.overwrite),
+                    **opts,
+                )
+            except KeyboardInterrupt:
+                print(
+                    f"eulerpoisson: interrupted; the finished chunks of {out} are kept: run the same command "
+                    f"again to resume",
+                    file=sys.stderr,
+                )
+                raise
+            except EulerPoissonError as exc:
+                raise type(exc)(
+                    str(exc)
+                    .replace("pass overwrite=True", "run again with --overwrite")
+                    .replace("overwrite=True", "--overwrite")
+                ) from exc
+        from ..trajectory import Trajectory
+
+        store = Trajectory.open(out)  # lazy: only the two samples below are read
+        traj = store[[0, len(store) - 1]]
+        traj.stats["wall_time"] = time.perf_counter() - start
+    else:
+        t = np.linspace(0.0, t_end, samples)
+        if out is None:  # nothing is written: keep the ends and the drift only (bounded memory)
+            traj, drift = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep=False)
+        else:
+            traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
+            with OutputLock(out):
+                traj.to_netcdf(out)
+    if out is not None:
+        drift = traj.drift()
+    if as_json:
+        print(json.dumps(_state_json(traj, drift)))
+    elif not args.quiet:
+        s = _state_json(traj, drift)
+        print(f"{traj.method}: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.3g} s")
+        if not model.is_free:
+            print(f"  torque        {model.describe()}")
+        print(f"  quaternion(T) = {np.round(s['quaternion'], 12).tolist()}")
+        print(f"  omega(T)      = {np.round(s['omega'], 12).tolist()}")
+        print(f"  energy        = {s['energy']:.15g}" + ("" if model.is_free else "  (kinetic + potential)"))
+        print("  relative drift: " + ", ".join(f"{k} {v:.2e}" for k, v in drift.items()))
+        if out is not None:
+            print(f"  wrote {out}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    """Register ``simulate`` on the subcommand parser ``sub``."""
+    from ..solvers import available_methods, get_method
+
+    ex = argparse.RawDescriptionHelpFormatter
+    s = sub.add_parser(
+        "simulate",
+        help="solve the motion of a body and print or save it",
+        formatter_class=ex,
+        description="Solve the motion of a rigid body, free or under torque, from an initial state.",
+        epilog=(
+            "examples:\n"
+            "  eulerpoisson simulate --inertia 3,5,8 --omega 0,0.4,0.001 --t-end 50 --json\n"
+            "  eulerpoisson simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 100 --method taylor --tol 1e-15 --out run.nc\n"
+            "  eulerpoisson simulate run.toml --t-end 20     # flags override the file\n"
+            "  eulerpoisson simulate --inertia 1,1,0.5 --omega 0,0,10 --gibbs 0.577,0,0 --com 0,0,0.25 --mass 1 \\\n"
+            "      --gravity 0,0,-9.81 --t-end 15 --out top.nc     # a heavy top (taylor by default)\n"
+            "  eulerpoisson plot top.nc --kind apex --out top_apex.png\n"
+            "  eulerpoisson simulate examples/heavy_top.toml --t-end 5   # the same top from a file ([torque])\n"
+            "  eulerpoisson simulate --inertia 1,2,3 --omega 0,0.001,0.001 --gravity-gradient 0.001 --t-end 6000 --json\n\n"
+            "TOML file sections: [body] inertia=[...] | masses=[...], positions=[[...]...]; name\n"
+            "  [initial] omega=[...] | m=[...]; quaternion=[w,x,y,z] | gibbs=[...]\n"
+            "  [time] t_end, samples   [method] name, tol, dt, scheme, order, integrator, rtol, atol\n"
+            "  [output] file, json\n"
+            "  [torque] center_of_mass=[...], mass, gravity=[...]; gravity_gradient; body_torque=[...]; space_torque=[...]\n\n"
+            "Torques: a heavy top is --com (centre of mass, body frame, from the fixed point; the inertia is about\n"
+            "the fixed point) with --mass (default 1) and --gravity (default 0,0,-9.81); --gravity-gradient NU is a\n"
+            "circular orbit of mean motion NU; --body-torque / --space-torque are constant torques. They add up.\n"
+            "Under a torque the default method is taylor; rk and symplectic run them too (see --method)."
+        ),
+    )
+    s.add_argument("config", nargs="?", help="optional TOML file describing the run")
+    s.add_argument("--inertia", help="principal moments I1,I2,I3 or nine numbers of a full tensor (row-major)")
+    s.add_argument("--omega", help="initial body angular velocity W1,W2,W3")
+    s.add_argument("--m", help="initial spatial angular momentum m1,m2,m3 (instead of --omega)")
+    s.add_argument("--quaternion", help="initial attitude w,x,y,z (unit, scalar first); default identity")
+    s.add_argument("--gibbs", help="initial attitude as the Gibbs vector n1,n2,n3")
+    s.add_argument("--t-end", dest="t_end", help="final time T (negative: the motion backwards from t = 0)")
+    s.add_argument(
+        "--allow-unphysical",
+        dest="allow_unphysical",
+        action="store_true",
+        default=None,
+        help="accept moments that violate the triangle inequality (e.g. 3,5,9: no mass distribution has them)",
+    )
+    s.add_argument("--samples", type=str, help="number of output times in [0, T] (default 1001)")
+    s.add_argument(
+        "--method", help="solution method: exact, taylor, symplectic, rk (default exact; taylor under a torque)"
+    )
+    for opt in METHOD_OPTIONS:  # every option of every method, read from the option dataclasses
+        owners = "; ".join(
+            f"{m}: default {get_method(m).options[opt]}" for m in available_methods() if opt in get_method(m).options
+        )
+        s.add_argument(
+            "--" + opt.replace("_", "-"), dest=opt, metavar=opt.upper(), help=f"method option {opt} ({owners})"
+        )
+    s.add_argument(
+        "--com",
+        metavar="CX,CY,CZ",
+        help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)",
+    )
+    s.add_argument("--mass", metavar="M", help="heavy top: mass M > 0 (default 1; needs --com)")
+    s.add_argument(
+        "--gravity",
+        metavar="GX,GY,GZ",
+        help="heavy top: gravitational acceleration, space frame (default 0,0,-9.81; needs --com)",
+    )
+    s.add_argument(
+        "--gravity-gradient",
+        dest="gravity_gradient",
+        metavar="NU",
+        help="gravity-gradient torque of a circular orbit with mean motion NU >= 0 (rad per time unit)",
+    )
+    s.add_argument("--body-torque", dest="body_torque", metavar="TX,TY,TZ", help="constant torque in the body frame")
+    s.add_argument("--space-torque", dest="space_torque", metavar="TX,TY,TZ", help="constant torque in the space frame")
+    s.add_argument("--out", help="write the trajectory to this NetCDF (.nc) file or stream it to a Zarr (.zarr) store")
+    s.add_argument(
+        "--json",
+        action="store_true",
+        help="print the state at T, the torques, the integrals at T and their drift as one JSON object",
+    )
+    s.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="replace an existing output of the same kind (an interrupted .zarr run resumes without it)",
+    )
+    s.add_argument(
+        "-j",
+        "--workers",
+        metavar="N",
+        help="threads that solve a batch of bodies (default: $EULERPOISSON_WORKERS, else every core; "
+        "1: one thread); the results do not depend on it",
+    )
+    s.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    s.set_defaults(func=cmd_simulate)

@@ -115,7 +115,9 @@ def test_store_plots_from_chunks_without_loading(store, long_run, monkeypatch):
 def test_envelope_does_not_depend_on_the_pieces(long_run, monkeypatch):
     """Memory is bounded by the piece: small pieces give the same picture."""
     big = plots.plot_omega(long_run)
-    monkeypatch.setattr(plots, "_PIECE", 997)
+    from eulerpoisson.viz import long_runs
+
+    monkeypatch.setattr(long_runs, "PIECE", 997)
     small = plots.plot_omega(long_run)
     for a, b in zip(big.axes[0].get_lines(), small.axes[0].get_lines()):
         np.testing.assert_array_equal(a.get_ydata(), b.get_ydata())

@@ -17,6 +17,7 @@ from eulerpoisson.cli import commands as cli
 from eulerpoisson.cli import main
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
 from eulerpoisson.io.atomic import atomic_path, atomic_write_text
+from eulerpoisson.solvers import engine
 
 BASE = ["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "1", "--samples", "3"]
 
@@ -256,7 +257,7 @@ def test_any_exception_is_one_line(capsys, monkeypatch, exc, match):
     def boom(*a, **k):
         raise exc
 
-    monkeypatch.setattr(ep.solvers, "solve", boom)
+    monkeypatch.setattr(engine, "prepare_run", boom)  # the one engine every route runs
     one_error(capsys, BASE, match)
     with pytest.raises(type(exc)):
         main(BASE + ["--debug"])  # --debug shows the traceback
@@ -278,7 +279,7 @@ def test_warnings_do_not_reach_stderr(capsys, monkeypatch):
         np.float64(1e308) * 10  # a real numpy warning too
         raise InvalidInputError("omega0 is too large")
 
-    monkeypatch.setattr(ep.solvers, "solve", noisy)
+    monkeypatch.setattr(engine, "prepare_run", noisy)  # the one engine every route runs
     before = list(warnings.filters)
     env_before = os.environ.get("PYTHONWARNINGS")
     one_error(capsys, BASE, r"^eulerpoisson: error: omega0 is too large$")
@@ -299,7 +300,7 @@ def test_debug_shows_warnings(capsys, monkeypatch):
         warnings.warn("look at me", RuntimeWarning, stacklevel=1)
         raise InvalidInputError("bad")
 
-    monkeypatch.setattr(ep.solvers, "solve", noisy)
+    monkeypatch.setattr(engine, "prepare_run", noisy)  # the one engine every route runs
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         with pytest.raises(InvalidInputError):

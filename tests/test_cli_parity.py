@@ -191,14 +191,18 @@ def test_a_file_with_non_unit_quaternions_is_refused(tmp_path):
         ep.Trajectory.from_netcdf(tmp_path / "b.nc")
 
 
-def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
+def test_a_long_stepping_run_goes_in_segments_with_progress(monkeypatch):
+    """A run of few samples but many turns is cut into segments (progress, resumable), the same in every route."""
     from eulerpoisson.cli import simulate as commands
+    from eulerpoisson.solvers import engine
 
-    monkeypatch.setattr(commands, "LONG_RUN_STEPS", 100)
+    monkeypatch.setattr(engine, "SEGMENT_TURNS", 100.0)
     t = np.linspace(0.0, 1e4, 5)
     model = ep.Model([1, 2, 3])
-    tr = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
-    assert tr.stats["chunks"] == 5
+    tr = commands.solve_run(model, 1e4, 5, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
+    assert tr.stats["segments"] == 4
+    same = ep.solve([1, 2, 3], t, omega0=[1, 0.1, 0.5], method="taylor")  # the same segments: the same bits
+    assert np.array_equal(tr.quaternion, same.quaternion) and np.array_equal(tr.omega, same.omega)
     ref = ep.solve([1, 2, 3], t, omega0=[1, 0.1, 0.5])
     assert np.max(np.abs(tr.quaternion - ref.quaternion)) < 1e-8
 
@@ -206,12 +210,10 @@ def test_a_long_stepping_run_goes_in_chunks_with_progress(monkeypatch):
 def test_a_run_written_nowhere_keeps_its_ends_and_the_same_drift():
     from eulerpoisson.cli import simulate as commands
 
-    t = np.linspace(0.0, 50.0, 12001)
     model = ep.Model([1, 2, 3])
-    full = commands._solve_in_chunks(model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False)
-    ends, drift = commands._solve_in_chunks(
-        model, t, np.array([1.0, 0.1, 0.5]), None, None, "taylor", {}, False, keep=False
-    )
+    w0 = np.array([1.0, 0.1, 0.5])
+    full = commands.solve_run(model, 50.0, 12001, w0, None, None, "taylor", {}, False)
+    ends, drift = commands.solve_run(model, 50.0, 12001, w0, None, None, "taylor", {}, False, keep=False)
     assert ends.t.tolist() == [0.0, 50.0]
     np.testing.assert_array_equal(ends.quaternion[-1], full.quaternion[-1])
     assert drift == full.drift()

@@ -196,7 +196,7 @@ def test_errors_are_those_of_one_thread(split_everything):
     assert str(many.value) == str(one.value)
 
 
-@pytest.mark.parametrize("bad", [0, -1, 2.5, 2.0, "2", True, np.True_, [2]])
+@pytest.mark.parametrize("bad", [0, -2, 2.5, 2.0, "2", True, np.True_, [2]])
 def test_invalid_workers_are_refused_by_name(bad):
     kind = InvalidInputError if isinstance(bad, int) and not isinstance(bad, bool) else TypeError
     with pytest.raises(kind, match="workers"):
@@ -319,3 +319,20 @@ def test_a_forked_child_gets_a_pool_of_its_own(split_everything):
             pytest.fail("the forked child did not finish its solve")
         time.sleep(0.05)
     assert os.waitstatus_to_exitcode(status) == 0
+
+
+def test_minus_one_means_every_core(monkeypatch):
+    """workers=-1 is every core, as scipy spells it (issue 21); the results are the bits of workers=1."""
+    import eulerpoisson as ep
+    from eulerpoisson.solvers.parallel import available_cores, check_workers, resolve_workers
+
+    assert resolve_workers(-1) == available_cores()
+    monkeypatch.setenv("EULERPOISSON_WORKERS", "-1")
+    assert resolve_workers(None) == available_cores()
+    with pytest.raises(ep.InvalidInputError, match="-1 or None for every core; got -2"):
+        check_workers(-2)
+    rng = np.random.default_rng(3)
+    w = rng.normal(size=(64, 3))
+    one = ep.solve([1.0, 2.0, 3.0], [0.0, 1.0, 5.0], omega0=w, method="taylor", workers=1)
+    every = ep.solve([1.0, 2.0, 3.0], [0.0, 1.0, 5.0], omega0=w, method="taylor", workers=-1)
+    assert np.array_equal(one.quaternion, every.quaternion) and np.array_equal(one.omega, every.omega)

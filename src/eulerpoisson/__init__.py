@@ -20,16 +20,6 @@ from .model.equations import Model
 from .solvers import available_methods, solve
 from .trajectory import Trajectory
 
-
-def _package_version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("eulerpoisson")
-    except PackageNotFoundError:  # pragma: no cover - running from a source tree
-        return "0+unknown"
-
-
 __all__ = [
     "__version__",
     "Attitude",
@@ -87,7 +77,9 @@ _LAZY_NAMES = {
 
 def __getattr__(name):
     if name == "__version__":
-        globals()[name] = value = _package_version()
+        from .version import package_version
+
+        globals()[name] = value = package_version()
         return value
     if name in _LAZY_NAMES:
         import importlib

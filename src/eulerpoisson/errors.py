@@ -15,6 +15,10 @@ __all__ = [
     "UnsupportedModelError",
     "SingularChartError",
     "MissingDependencyError",
+    "UsageError",
+    "OutputError",
+    "FitInputError",
+    "AuditError",
 ]
 
 
@@ -79,7 +83,7 @@ class UnsupportedModelError(InvalidInputError):
     ...     ep.solve([1.0, 2.0, 2.5], [1.0], omega0=[1.0, 0.1, 0.5], torque=damping, method="taylor")
     ... except ep.UnsupportedModelError as err:
     ...     print(err)
-    method 'taylor' cannot run this model: ...; methods that can: rk
+    method 'taylor' cannot run this model: ...; methods that can: rk, rk4
     """
 
 
@@ -149,3 +153,32 @@ def require(module: str, extra: str):
         raise MissingDependencyError(
             f"{module!r} is required for this feature; install it with pip install 'eulerpoisson[{extra}]'"
         ) from exc
+
+
+class UsageError(EulerPoissonError, ValueError):
+    """Bad command-line input (exit status 2)."""
+
+
+class AuditError(EulerPoissonError, RuntimeError):
+    """Internal inconsistency of the audit (e.g. exact and random-point verdicts disagree)."""
+
+
+class FitInputError(InvalidInputError):
+    """Observations or options that a fit cannot use (a ValueError).
+
+    Examples
+    --------
+    >>> import numpy as np, eulerpoisson as ep
+    >>> from eulerpoisson.estimation import FitInputError
+    >>> try:
+    ...     ep.fit([0.0, 1.0, 2.0])                                    # no observations at all
+    ... except FitInputError as err:
+    ...     print(err)
+    no observations: give attitude, omega or axis_direction (rows of NaN are missing ones)
+    >>> issubclass(FitInputError, ValueError)
+    True
+    """
+
+
+class OutputError(EulerPoissonError, FileExistsError):
+    """An output that may not be written: it exists (no overwrite), is an input, is of another kind, or is locked."""

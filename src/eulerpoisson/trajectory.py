@@ -10,18 +10,15 @@ Trajectories are written to and read from NetCDF with CF-style attributes.
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
-from datetime import UTC, datetime
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from .attitude.core import matrix_from_unit_quaternion, quaternion_make_continuous
-from .errors import EulerPoissonError, InvalidInputError, require
-from .io.atomic import atomic_path
+from .errors import InvalidInputError
 from .model.body import RigidBody
 from .model.equations import Model
 from .util.validate import as_float_array
@@ -46,7 +43,7 @@ CONVENTIONS = (
 )
 
 
-def _unit_continuous(t: np.ndarray, q: np.ndarray) -> np.ndarray:
+def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> np.ndarray:
     """Quaternions (..., T, 4) as a trajectory stores them: normalized, with signs continuous in time.
 
     Body by body along the time axis (``t``, any order): any split of a batch gives the same bits.
@@ -66,6 +63,8 @@ def _unit_continuous(t: np.ndarray, q: np.ndarray) -> np.ndarray:
     off = np.abs(nrm - 1.0) > 4 * np.finfo(float).eps
     if np.any(off):
         q = np.where(off, q / nrm, q)
+    if not continuous:
+        return q
     if t.size < 2 or np.all(t[1:] >= t[:-1]):  # the usual case: no reordering needed
         return quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
     order = np.argsort(t, kind="stable")
@@ -115,6 +114,11 @@ class Trajectory:
         The method's options.
     stats : dict, optional
         Counters (wall time, steps, ...).
+    keep_signs : bool, default False
+        Keep the sign of every quaternion as given (normalized only): for
+        samples selected from a trajectory whose signs were made continuous
+        over all its samples (indexing does this), where continuity over the
+        selection alone could flip some. Keyword only.
 
     Raises
     ------
@@ -163,6 +167,7 @@ class Trajectory:
         stats: dict[str, Any] | None = None,
         *,
         torque: TorqueLike = None,
+        keep_signs: bool = False,
         _prepared: bool = False,
     ) -> None:
         # _prepared (private, for the solve driver): ``quaternion`` and ``omega`` are float64 arrays already
@@ -197,7 +202,12 @@ class Trajectory:
                 f"the body's batch shape {body.batch_shape} does not broadcast to the trajectory's batch "
                 f"shape {bshape} (quaternion {q.shape}, omega {self.omega.shape})"
             )
-        self.quaternion = q if _prepared else _unit_continuous(self.t, q)
+        if _prepared:
+            self.quaternion = q
+        elif keep_signs:
+            self.quaternion = _unit_continuous(self.t, q, continuous=False)  # normalized only
+        else:
+            self.quaternion = _unit_continuous(self.t, q)
         self.body = body
         self.model = Model(body, torque)
         if self.model.batch_shape != () and np.broadcast_shapes(self.model.batch_shape, bshape) != bshape:
@@ -366,7 +376,7 @@ class Trajectory:
 
     # ------------------------------------------------------------------
     def to_xarray(self) -> xarray.Dataset:
-        """The trajectory as an :class:`xarray.Dataset` with CF-style attributes.
+        """The trajectory as an :class:`xarray.Dataset` with CF-style attributes: :func:`eulerpoisson.io.netcdf.to_xarray`.
 
         Batches are flattened to a ``body`` dimension (the batch shape is kept
         in the ``batch_shape`` attribute).
@@ -376,174 +386,27 @@ class Trajectory:
         MissingDependencyError
             If xarray is not installed (extra ``io``).
         """
-        xr = require("xarray", "io")
-        data, coords, attrs = self._netcdf_content()
-        return xr.Dataset(data, coords=coords, attrs=attrs)
+        from .io import netcdf
 
-    def _netcdf_content(self):
-        """The variables ``{name: (dims, values, attrs)}``, coordinates and global attributes of the file."""
-        from . import __version__
-
-        bshape = self.batch_shape
-        nb = int(np.prod(bshape)) if bshape else 0
-        T = len(self.t)
-
-        def flat(a, tail):
-            return a.reshape((nb,) + a.shape[len(bshape) :]) if bshape else a
-
-        bdim = ("body",) if bshape else ()
-        inertia = np.broadcast_to(self.body.inertia, bshape + (3, 3))
-        data = {
-            "quaternion": (
-                bdim + ("time", "quat"),
-                flat(self.quaternion, 2),
-                {"long_name": "attitude quaternion, scalar first (w, x, y, z); x_space = R(q) x_body", "units": "1"},
-            ),
-            "omega": (
-                bdim + ("time", "axis"),
-                flat(self.omega, 2),
-                {"long_name": "body angular velocity Omega (body frame)", "units": "rad s-1"},
-            ),
-            "M": (
-                bdim + ("time", "axis"),
-                flat(self.M, 2),
-                {"long_name": "body angular momentum M = I Omega (body frame)", "units": "kg m2 s-1"},
-            ),
-            "m": (
-                bdim + ("time", "axis"),
-                flat(self.m, 2),
-                {"long_name": "spatial angular momentum m = R I Omega (space frame)", "units": "kg m2 s-1"},
-            ),
-            "energy": (
-                bdim + ("time",),
-                flat(self.energy, 1),
-                {
-                    "long_name": (
-                        "kinetic energy E = Omega.I Omega/2"
-                        if self.model.is_free
-                        else "energy E = Omega.I Omega/2 + U (kinetic plus the potential of the torques)"
-                    ),
-                    "units": "J",
-                },
-            ),
-            "gibbs": (
-                bdim + ("time", "axis"),
-                flat(self.gibbs, 2),
-                {
-                    "long_name": "Gibbs rotation vector n = k tan(alpha/2) (paper eq. 1.8); NaN at alpha = pi",
-                    "units": "1",
-                },
-            ),
-            "inertia": (
-                bdim + ("axis", "axis2"),
-                flat(inertia, 2),
-                {"long_name": "inertia tensor in the body frame", "units": "kg m2"},
-            ),
-        }
-        if self.body.positions is not None and not bshape:
-            data["particle_masses"] = (("particle",), self.body.masses, {"long_name": "point masses", "units": "kg"})
-            data["particle_positions"] = (
-                ("particle", "axis"),
-                self.body.positions,
-                {"long_name": "particle positions relative to the centre of mass at t = 0 (body frame)", "units": "m"},
-            )
-            data["center_of_mass"] = (
-                ("axis",),
-                self.body.center_of_mass,
-                {"long_name": "centre of mass", "units": "m"},
-            )
-        coords = {
-            "time": ("time", self.t, {"long_name": "time", "units": "s", "standard_name": "time"}),
-            "quat": ("quat", np.array(["w", "x", "y", "z"])),
-            "axis": ("axis", np.array(["x", "y", "z"])),
-            "axis2": ("axis2", np.array(["x", "y", "z"])),
-        }
-        attrs = {
-            "title": (
-                f"free rigid body trajectory ({self.method})"
-                if self.model.is_free
-                else f"rigid body under torque: {self.model.describe()} ({self.method})"
-            ),
-            "torque": json.dumps(_torque_records(self.model.torques)),
-            "Conventions": "CF-1.10",
-            "eulerpoisson_conventions": CONVENTIONS,
-            "eulerpoisson_format_version": FORMAT_VERSION,
-            "eulerpoisson_version": __version__,
-            "method": self.method,
-            "method_options": json.dumps(self.options, default=float, sort_keys=True),
-            "stats": json.dumps(self.stats, default=float, sort_keys=True),
-            "batch_shape": json.dumps(list(bshape)),
-            "body_name": self.body.name or "",
-            "T": T,
-            "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} written by eulerpoisson {__version__}",
-            "references": "A. A. Deriglazov, Geodesic motion on the symplectic leaf of SO(3) ... (the paper)",
-        }
-        return data, coords, attrs
+        return netcdf.to_xarray(self)
 
     def to_netcdf(self, path: str | os.PathLike[str]) -> None:
-        """Write the trajectory to a NetCDF-4 file, atomically (temporary file, then rename).
+        """Write the trajectory to a NetCDF-4 file, atomically: :func:`eulerpoisson.io.netcdf.write_netcdf`.
 
         Raises
         ------
         MissingDependencyError
-            If xarray or h5netcdf is missing (extra ``io``).
+            If h5netcdf is missing (extra ``io``).
+        OSError
+            The file cannot be written (the message names it).
         """
-        import io
+        from .io import netcdf
 
-        h5netcdf = require("h5netcdf", "io")
-        content, coords, attrs = self._netcdf_content()
-        # HDF5 writes into memory first; the file itself is written by plain Python I/O, so a full disk is
-        # an OSError naming the file (HDF5 left with a half-written file on a full disk crashed the
-        # interpreter at exit), and nothing is left behind. h5netcdf directly, not through xarray: the
-        # same file (xarray reads back the dataset of to_xarray(), a test checks) without importing
-        # xarray and dask on every run of the command line.
-        variables = {name: (v if len(v) == 3 else (*v, {})) for name, v in {**coords, **content}.items()}
-        dims: dict[str, int] = {}
-        for dnames, values, _ in variables.values():
-            dnames = (dnames,) if isinstance(dnames, str) else tuple(dnames)
-            for d, n in zip(dnames, np.shape(values)):
-                dims.setdefault(d, n)
-        buf = io.BytesIO()
-        with h5netcdf.File(buf, "w") as f:
-            f.dimensions = dims
-            for name, (dnames, values, vattrs) in variables.items():
-                dnames = (dnames,) if isinstance(dnames, str) else tuple(dnames)
-                values = np.asarray(values)
-                if values.dtype.kind == "U":
-                    import h5py
-
-                    var = f.create_variable(name, dnames, dtype=h5py.string_dtype())
-                    var[...] = values.astype(object)
-                else:
-                    var = f.create_variable(
-                        name,
-                        dnames,
-                        dtype=values.dtype,
-                        data=values,
-                        fillvalue=np.nan if values.dtype.kind == "f" else None,
-                    )
-                for k, val in vattrs.items():
-                    var.attrs[k] = val
-            for k, val in attrs.items():
-                f.attrs[k] = val
-        data = buf.getbuffer()
-        from .io.atomic import write_error
-
-        with atomic_path(path) as tmp:
-            try:
-                with open(tmp, "wb") as fh:
-                    fh.write(data)
-            except OSError as exc:
-                raise write_error(path, exc) from None
+        netcdf.write_netcdf(self, path)
 
     @classmethod
     def from_netcdf(cls, path: str | os.PathLike[str]) -> Trajectory:
-        """Read a trajectory written by :meth:`to_netcdf`.
-
-        Parameters
-        ----------
-        path : str or os.PathLike
-            The file.
+        """Read a trajectory written by :meth:`to_netcdf`: :func:`eulerpoisson.io.netcdf.read_netcdf`.
 
         Returns
         -------
@@ -552,144 +415,12 @@ class Trajectory:
 
         Raises
         ------
-        TypeError
-            ``path`` is not a file name (``str``, ``bytes`` or ``os.PathLike``).
-        FileNotFoundError
-            If the file does not exist.
-        EulerPoissonError
-            If the file is not a readable NetCDF file or not an eulerpoisson
-            trajectory, or was written by a newer, unknown format version.
-        InvalidInputError
-            A malformed trajectory file; the message names the file and the
-            attribute or variable: a missing variable (``time``, ``inertia``,
-            particle data), a format version that is not a positive integer,
-            attributes (``batch_shape``, ``method_options``, ``stats``) that
-            are not the JSON written by :meth:`to_netcdf`, variables whose
-            shapes do not match ``batch_shape`` and the number of times, or
-            values the constructors reject (NaN, a non-physical inertia
-            tensor: :class:`InvalidInertiaError`), or a stored ``M`` that
-            disagrees with ``inertia @ omega`` (an edited file).
-        MissingDependencyError
-            If xarray or h5netcdf is missing (extra ``io``).
+        TypeError, FileNotFoundError, EulerPoissonError, InvalidInputError, MissingDependencyError
+            As :func:`eulerpoisson.io.netcdf.read_netcdf`.
         """
-        import os
+        from .io import netcdf
 
-        if not isinstance(path, (str, bytes, os.PathLike)):
-            raise TypeError(f"path must be a file name (str or os.PathLike), got {type(path).__name__} {path!r}")
-        if isinstance(path, bytes):
-            path = os.fsdecode(path)  # named as text in the messages below, not b'...'
-        xr = require("xarray", "io")
-        if not os.path.exists(path):
-            raise FileNotFoundError(f"no such file: {path}")
-        try:
-            from .io.read import netcdf_engine  # NetCDF-3 (classic) files through scipy, NetCDF-4 through h5netcdf
-
-            ds = xr.load_dataset(path, engine=netcdf_engine(path))
-        except Exception as exc:
-            raise EulerPoissonError(f"{path} is not a readable NetCDF file: {exc}") from exc
-        ver = ds.attrs.get("eulerpoisson_format_version")
-        if ver is None or "quaternion" not in ds or "omega" not in ds:
-            raise EulerPoissonError(f"{path} is not an eulerpoisson trajectory file")
-        ver = format_version(path, ver)
-        if ver > FORMAT_VERSION:
-            raise EulerPoissonError(
-                f"{path} has format version {ver}, newer than this eulerpoisson ({FORMAT_VERSION}); upgrade the package"
-            )
-        need = ["time", "inertia"]
-        if "particle_masses" in ds:
-            need += ["particle_positions", "center_of_mass"]
-        missing = [v for v in need if v not in ds]
-        if missing:
-            raise InvalidInputError(
-                f"{path}: malformed eulerpoisson trajectory file, variable(s) {missing} missing "
-                f"(expected {need} besides quaternion and omega)"
-            )
-        bshape = json_attr(path, ds, "batch_shape", "[]", list)
-        if not all(isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in bshape):
-            raise InvalidInputError(
-                f"{path}: attribute batch_shape must be a JSON list of non-negative integers, got {bshape!r}"
-            )
-        bshape = tuple(bshape)
-        options = json_attr(path, ds, "method_options", "{}", dict)
-        stats = json_attr(path, ds, "stats", "{}", dict)
-        t = ds["time"].values
-        q = ds["quaternion"].values
-        w = ds["omega"].values
-        inertia = ds["inertia"].values
-        if t.ndim != 1:
-            raise InvalidInputError(f"{path}: variable time must be 1-D, got shape {t.shape}")
-        lead = (int(np.prod(bshape)),) if bshape else ()
-        for nm, a, tail in (
-            ("quaternion", q, (t.shape[0], 4)),
-            ("omega", w, (t.shape[0], 3)),
-            ("inertia", inertia, (3, 3)),
-        ):
-            if a.shape != lead + tail:
-                raise InvalidInputError(
-                    f"{path}: variable {nm} has shape {a.shape}, expected {lead + tail} "
-                    f"(batch_shape {list(bshape)}, {t.shape[0]} times)"
-                )
-        if t.size > 1 and np.all(t == t[0]):
-            raise InvalidInputError(
-                f"{path}: the time variable holds the same value {float(t[0])!r} for all "
-                f"{t.size} samples: the file was modified or is not ours"
-            )
-        from .attitude.core import UNIT_QUATERNION_TOLERANCE
-
-        with np.errstate(invalid="ignore", over="ignore"):
-            norms = np.sqrt(np.sum(np.asarray(q, dtype=float) ** 2, axis=-1))
-        norms = norms[np.isfinite(norms)]  # NaN and inf are named by the checks below
-        if norms.size and not np.all(np.abs(norms - 1.0) <= UNIT_QUATERNION_TOLERANCE):
-            worst = float(norms[np.argmax(np.abs(norms - 1.0))])
-            raise InvalidInputError(
-                f"{path}: the quaternion variable is not made of unit quaternions (a norm of {worst:.9g}; "
-                f"we write norm 1 within {UNIT_QUATERNION_TOLERANCE:g}): the file was modified or is not ours"
-            )
-        if bshape:
-            q = q.reshape(bshape + q.shape[1:])
-            w = w.reshape(bshape + w.shape[1:])
-            inertia = inertia.reshape(bshape + (3, 3))
-        name = ds.attrs.get("body_name") or None
-        try:
-            if "particle_masses" in ds:
-                body = RigidBody.from_particles(
-                    ds["particle_masses"].values,
-                    ds["particle_positions"].values + ds["center_of_mass"].values,
-                    name=name if name is None else str(name),
-                )
-            else:
-                body = RigidBody(inertia, name=name if name is None else str(name), allow_unphysical=True)
-            traj = cls(
-                t=t,
-                quaternion=q,
-                omega=w,
-                body=body,
-                method=str(ds.attrs.get("method", "")),
-                options=options,
-                stats=stats,
-                torque=read_torques(path, ds),
-            )
-        except (InvalidInputError, TypeError) as exc:  # name the file (the type is kept)
-            raise type(exc)(f"{path}: {exc}") from exc
-        # the stored M = I Omega must agree with the inertia and omega read back (an edited inertia
-        # or omega would otherwise give a silently different motion)
-        Mf = ds["M"].values if "M" in ds else None
-        if (
-            Mf is not None
-            and t.size
-            and np.issubdtype(Mf.dtype, np.floating)
-            and Mf.shape == lead + (t.shape[0], 3)
-            and np.all(np.isfinite(Mf))
-        ):
-            Mf = Mf.reshape(traj.M.shape)
-            scale = np.max(np.abs(Mf), axis=(-1, -2), keepdims=True)
-            err = np.max(np.abs(traj.M - Mf) / np.where(scale > 0, scale, 1.0))
-            if not err <= 1e-9:
-                raise InvalidInputError(
-                    f"{path}: inconsistent file: the stored body angular momentum M differs from "
-                    f"inertia @ omega by {err:.3g} (relative); the inertia or omega variable was modified"
-                )
-        return traj
+        return netcdf.read_netcdf(path)
 
     @classmethod
     def open(cls, path: str | os.PathLike[str]) -> Trajectory | LazyTrajectory:
@@ -746,6 +477,7 @@ class Trajectory:
             self.options,
             self.stats,
             torque=list(self.model.torques),
+            keep_signs=True,  # the signs of the whole trajectory: a selection never flips a sample
         )
 
     def sel(self, t: ArrayLike, method: str | None = None) -> Trajectory:
@@ -784,18 +516,20 @@ class Trajectory:
         return self[order[pick]]
 
     def __call__(self, t: ArrayLike, **options: Any) -> Trajectory:
-        r"""The motion at any times ``t``: recomputed from the first sample by the trajectory's method.
+        r"""The motion at any times ``t``: :func:`eulerpoisson.solvers.engine.evaluate`.
 
         The closed form (``exact``) evaluates the same solution at the new
-        times; an integrator integrates again from ``t[0]`` with the same
-        options (its error is of the same size as the trajectory's own).
+        times (from the nearest sample, exactly); an integrator continues from
+        the nearest stored sample of each time (a short integration with the
+        trajectory's method and options: the dense output, with the
+        trajectory's own error at that sample), never from ``t[0]``.
         Time-dependent torques are continued at the right phase. ``options``
         override the method's options.
 
         Parameters
         ----------
         t : float or array_like, shape (T,)
-            Any times (before ``t[0]`` too).
+            Any times (before ``t[0]`` and after ``t[-1]`` too: continued from the end samples).
 
         Returns
         -------
@@ -804,26 +538,11 @@ class Trajectory:
         Raises
         ------
         InvalidInputError
-            An empty trajectory, or a method that is not known.
+            An empty trajectory, bad times, or a method that is not known.
         """
-        from .io.stream import solve_from
-        from .solvers import available_methods
+        from .solvers.engine import evaluate
 
-        if self.t.size == 0:
-            raise InvalidInputError("a trajectory with no output times cannot be evaluated: it has no state")
-        i0 = int(np.argmin(self.t))
-        method = self.method if self.method in available_methods() else ("exact" if self.model.is_free else "taylor")
-        opts = {**({} if method != self.method else self.options), **options}
-        times = np.atleast_1d(as_float_array(t, "t"))
-        return solve_from(
-            self.model,
-            times,
-            float(self.t[i0]),
-            self.quaternion[..., i0, :],
-            self.omega[..., i0, :],
-            method=method,
-            **opts,
-        )
+        return evaluate(self, t, **options)
 
     def plot(self, kind: str = "omega", **kwargs: Any) -> Figure:
         """A picture of the trajectory: :func:`eulerpoisson.viz.plots.plot` (``kind``: omega, invariants,
@@ -845,63 +564,3 @@ class Trajectory:
         from .util.htmlrepr import trajectory_html
 
         return trajectory_html(self)
-
-
-def _torque_records(torques) -> list[dict]:
-    """JSON-able records of the torques; a callable is recorded by name (it cannot be read back as code)."""
-    out = []
-    for tq in torques:
-        try:
-            out.append(tq.to_dict())
-        except NotImplementedError:
-            out.append({"kind": "unrecorded", "description": repr(tq)})
-    return out
-
-
-def read_torques(path, ds):
-    """The torques of a file's ``torque`` attribute (absent: the free body)."""
-    from .model.torques import Torque, UnrecordedTorque, torque_from_dict
-
-    raw = ds.attrs.get("torque")
-    if raw is None or raw == "":
-        return None
-    try:
-        records = json.loads(str(raw))
-    except ValueError:
-        raise InvalidInputError(f"{path}: the torque attribute is not valid JSON: {str(raw)[:80]!r}") from None
-    if not isinstance(records, list):
-        raise InvalidInputError(f"{path}: the torque attribute must be a JSON list of records, got {str(raw)[:80]!r}")
-    out: list[Torque] = []
-    for rec in records:
-        if isinstance(rec, dict) and rec.get("kind") == "unrecorded":
-            out.append(UnrecordedTorque(str(rec.get("description", ""))))
-        else:
-            try:
-                out.append(torque_from_dict(rec))
-            except (InvalidInputError, TypeError) as exc:
-                raise InvalidInputError(f"{path}: torque attribute: {exc}") from None
-    return out
-
-
-def format_version(path, ver) -> int:
-    """The ``eulerpoisson_format_version`` attribute as a positive int, or InvalidInputError."""
-    v = ver.item() if isinstance(ver, np.ndarray) and ver.size == 1 else ver
-    if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v < 1:
-        raise InvalidInputError(
-            f"{path}: attribute eulerpoisson_format_version must be a positive integer, got {ver!r}"
-        )
-    return int(v)
-
-
-def json_attr(path, ds, key: str, default: str, kind: type):
-    """Decode the JSON attribute ``key`` (a ``kind``: list or dict), or InvalidInputError naming the file."""
-    raw = ds.attrs.get(key, default)
-    try:
-        val = json.loads(raw)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{path}: attribute {key} is not valid JSON ({exc}): {str(raw)[:80]!r}") from exc
-    if not isinstance(val, kind):
-        raise InvalidInputError(
-            f"{path}: attribute {key} must be a JSON {'list' if kind is list else 'object'}, got {raw!r}"
-        )
-    return val

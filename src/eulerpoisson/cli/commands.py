@@ -20,7 +20,7 @@ from .info import cmd_info  # noqa: F401
 from .main import build_parser, cmd_demo, main  # noqa: F401
 from .main import prepare_argv as _prepare_argv  # noqa: F401 - the tests import it under its old name
 from .plot import FPS_RANGE, MAX_FRAMES, cmd_animate, cmd_plot  # noqa: F401
-from .simulate import CHUNKED_SAMPLES, CHUNKS, LONG_RUN_STEPS, MAX_SAMPLES, cmd_simulate  # noqa: F401
+from .simulate import CHUNKED_SAMPLES, MAX_SAMPLES, cmd_simulate  # noqa: F401
 from .sweep import cmd_sweep  # noqa: F401
 
 __all__ = ["main"]

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import EulerPoissonError, MissingDependencyError
+from ..errors import EulerPoissonError, MissingDependencyError, UsageError
 
 __all__ = [
     "EXIT_USAGE",
@@ -30,10 +30,6 @@ __all__ = [
 ]
 
 EXIT_USAGE = 2
-
-
-class UsageError(EulerPoissonError, ValueError):
-    """Bad command-line input (exit status 2)."""
 
 
 class Parser(argparse.ArgumentParser):
@@ -135,7 +131,7 @@ def naming_target(target):
 
 def read_trajectory(path):
     """The trajectory in ``path``: NetCDF-4 or NetCDF-3 (in memory), or a .zarr store (read lazily)."""
-    from ..io.read import file_format
+    from ..io.formats import file_format
     from ..trajectory import Trajectory
 
     check_file_name(path, "trajectory file")

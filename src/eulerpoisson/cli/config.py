@@ -4,6 +4,12 @@ A TOML file is checked and flattened to ``{"section.key": value}``; the
 flags replace what the file says; the body, the torques and the method
 options are built from the merged configuration, with messages that name
 the flag or the ``file: [section] key`` each value came from.
+
+The torque flags and the ``[torque]`` keys are those of the registered
+torques (:data:`eulerpoisson.torques.TORQUES`, each class's
+:attr:`~eulerpoisson.torques.Torque.cli`): a new torque class with a ``cli``
+gets its flags, its TOML keys and its place in :func:`build_torques` with no
+edit here, as the method options come from the methods' option dataclasses.
 """
 
 from __future__ import annotations
@@ -12,6 +18,7 @@ import json
 import math
 import os
 
+from ..model.torques import TORQUES, Torque, TorqueParam
 from .common import UsageError, inertia_from, parse_floats
 
 __all__ = [
@@ -23,6 +30,9 @@ __all__ = [
     "build_body",
     "build_torques",
     "method_options",
+    "torque_params",
+    "torque_toml_keys",
+    "sync_torque_keys",
 ]
 
 
@@ -51,6 +61,38 @@ def _method_option_kinds() -> dict[str, str]:
     return kinds
 
 
+def torque_params() -> list[tuple[type, TorqueParam]]:
+    """``(torque class, TorqueParam)`` of every command-line parameter of every registered torque.
+
+    In the order of :data:`~eulerpoisson.torques.TORQUES` and, within a class,
+    of its :attr:`~eulerpoisson.torques.Torque.cli`: the order of the flags in
+    ``simulate --help``.
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli.config import torque_params
+    >>> [p.flag for _, p in torque_params()][:4]
+    ['--com', '--mass', '--gravity', '--gravity-gradient']
+    """
+    return [(cls, p) for cls in TORQUES.values() for p in cls.cli]
+
+
+def torque_toml_keys() -> str:
+    """The keys of ``[torque]`` as ``simulate --help`` lists them: a class's keys joined by commas, classes by ``;``.
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli.config import torque_toml_keys
+    >>> torque_toml_keys().split("; ")[:2]
+    ['center_of_mass=[...], mass, gravity=[...]', 'gravity_gradient']
+    """
+    return "; ".join(
+        ", ".join(p.toml_key + ("=[...]" if p.toml_kind == "numbers" else "") for p in cls.cli)
+        for cls in TORQUES.values()
+        if cls.cli
+    )
+
+
 #: the options of the methods, from their dataclasses (``ep.solvers.TaylorOptions`` ...): flags and TOML keys
 METHOD_OPTIONS = _method_option_kinds()
 
@@ -67,14 +109,8 @@ _TOML_KINDS = {
     "time": {"t_end": "number", "samples": "int"},
     "method": {"name": "str", **METHOD_OPTIONS},
     "output": {"file": "str", "json": "bool"},
-    "torque": {
-        "gravity": "numbers",
-        "mass": "number",
-        "center_of_mass": "numbers",
-        "gravity_gradient": "number",
-        "body_torque": "numbers",
-        "space_torque": "numbers",
-    },
+    # the parameters of the registered torques (sync_torque_keys brings it up to date with TORQUES)
+    "torque": {p.toml_key: p.toml_kind for _, p in torque_params()},
     "compute": {"workers": "int"},
 }
 _TOML_KEYS = {sec: set(keys) for sec, keys in _TOML_KINDS.items()}
@@ -138,6 +174,7 @@ def config_from_toml(cfg: dict, path: str, src: dict | None = None) -> dict:
     ``src`` (if given) receives, for each key, the name used in messages
     (``"run.toml: [method] order"``).
     """
+    sync_torque_keys()
     out: dict = {}
     for section, body in cfg.items():
         if section not in _TOML_KEYS:
@@ -173,14 +210,33 @@ FLAGS = {
     "method.name": "--method",
     **{f"method.{k}": "--" + k.replace("_", "-") for k in METHOD_OPTIONS},
     "output.file": "--out",
-    "torque.gravity": "--gravity",
-    "torque.mass": "--mass",
-    "torque.center_of_mass": "--com",
-    "torque.gravity_gradient": "--gravity-gradient",
-    "torque.body_torque": "--body-torque",
-    "torque.space_torque": "--space-torque",
+    **{f"torque.{p.toml_key}": p.flag for _, p in torque_params()},
     "compute.workers": "--workers",
 }
+
+
+def sync_torque_keys() -> None:
+    """Bring :data:`FLAGS` and the ``[torque]`` keys of the TOML schema up to date with the torque registry.
+
+    A torque registered after this module was imported
+    (:func:`eulerpoisson.torques.register_torque`) gets its flags and keys;
+    one removed from the registry loses them. ``simulate`` calls it when it
+    builds its parser and reads its configuration.
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli.config import FLAGS, sync_torque_keys
+    >>> sync_torque_keys()
+    >>> FLAGS["torque.magnetic_field"]
+    '--magnetic-field'
+    """
+    params = torque_params()
+    flags = {f"torque.{p.toml_key}": p.flag for _, p in params}
+    for key in [k for k in FLAGS if k.startswith("torque.") and k not in flags]:
+        del FLAGS[key]
+    FLAGS.update(flags)
+    _TOML_KINDS["torque"] = {p.toml_key: p.toml_kind for _, p in params}
+    _TOML_KEYS["torque"] = set(_TOML_KINDS["torque"])
 
 
 def namer(src: dict):
@@ -243,39 +299,62 @@ def _number(value, name: str, *, positive: bool = False) -> float:
     return x
 
 
+#: how :func:`build_torques` names a required parameter left out, where the class's own words are kept
+#: (``(kind, parameter)``: (what, a note after the flag)); other parameters are named from their class
+_NEEDED = {
+    ("gravity", "center_of_mass"): ("the centre of mass of the heavy top", " (body frame, from the fixed point)"),
+}
+
+
+def _param_value(p: TorqueParam, value, where: str):
+    """The value of a torque parameter from a flag's text or a TOML value, checked by its kind."""
+    if p.kind == "vector3":
+        return parse_floats(value, where, (3,))
+    return _number(value, where, positive=p.kind == "positive")
+
+
 def build_torques(cfg, name=None) -> list:
-    """The torques of ``[torque]`` / the torque flags, in the order gravity, gravity gradient, body, space.
+    """The torques of ``[torque]`` / the torque flags, in the order of the torque registry.
 
-    A heavy top needs the centre of mass (``--com``); the mass defaults to 1 and
-    the gravitational acceleration to (0, 0, -9.81).
+    Each registered torque with command-line parameters (:attr:`~eulerpoisson.torques.Torque.cli`)
+    is built (:meth:`~eulerpoisson.torques.Torque.from_params`) when any of
+    its parameters is given: gravity, gravity gradient, body, space, magnetic
+    dipole. A parameter given without a required one of its torque is an
+    error naming both: a heavy top needs the centre of mass (``--com``); the
+    mass defaults to 1 and the gravitational acceleration to (0, 0, -9.81).
+
+    Raises
+    ------
+    UsageError
+        A value that is not what its parameter takes, or a required parameter left out
+        (the message names the flag or the ``file: [torque] key`` of the value).
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli.config import build_torques
+    >>> build_torques({"torque.center_of_mass": "0,0,0.1", "torque.body_torque": [0.0, 0.0, 1.0]})
+    [Gravity(mass=1.0, center_of_mass=[0.0, 0.0, 0.1], g=[0.0, 0.0, -9.81]), BodyTorque(tau=[0.0, 0.0, 1.0])]
     """
-    from ..model.torques import STANDARD_GRAVITY, BodyTorque, Gravity, GravityGradient, SpaceTorque, Torque
-
+    sync_torque_keys()
     name = name or namer({})
     torques: list[Torque] = []
-    if "torque.center_of_mass" in cfg:
-        com = parse_floats(cfg["torque.center_of_mass"], name("torque.center_of_mass"), (3,))
-        mass = _number(cfg["torque.mass"], name("torque.mass"), positive=True) if "torque.mass" in cfg else 1.0
-        g = (
-            parse_floats(cfg["torque.gravity"], name("torque.gravity"), (3,))
-            if "torque.gravity" in cfg
-            else [0.0, 0.0, -STANDARD_GRAVITY]
-        )
-        torques.append(Gravity(mass, com, g))
-    else:
-        for key in ("torque.mass", "torque.gravity"):
-            if key in cfg:
-                raise UsageError(
-                    f"{name(key)} needs the centre of mass of the heavy top: "
-                    f"{FLAGS['torque.center_of_mass']} CX,CY,CZ (body frame, from the fixed point) "
-                    "or [torque] center_of_mass"
-                )
-    if "torque.gravity_gradient" in cfg:
-        torques.append(GravityGradient(_number(cfg["torque.gravity_gradient"], name("torque.gravity_gradient"))))
-    if "torque.body_torque" in cfg:
-        torques.append(BodyTorque(parse_floats(cfg["torque.body_torque"], name("torque.body_torque"), (3,))))
-    if "torque.space_torque" in cfg:
-        torques.append(SpaceTorque(parse_floats(cfg["torque.space_torque"], name("torque.space_torque"), (3,))))
+    for cls in TORQUES.values():
+        given = [p for p in cls.cli if f"torque.{p.toml_key}" in cfg]
+        if not given:
+            continue
+        missing = [p for p in cls.cli if p.required and p not in given]
+        if missing:
+            need = missing[0]
+            what, note = _NEEDED.get(
+                (cls.kind, need.name),
+                (f"the {need.name.replace('_', ' ')} of the {cls.kind.replace('_', ' ')} torque", ""),
+            )
+            raise UsageError(
+                f"{name(f'torque.{given[0].toml_key}')} needs {what}: {need.flag} {need.metavar}{note} "
+                f"or [torque] {need.toml_key}"
+            )
+        values = {p.name: _param_value(p, cfg[f"torque.{p.toml_key}"], name(f"torque.{p.toml_key}")) for p in given}
+        torques.append(cls.from_params(values))
     return torques
 
 

@@ -133,20 +133,23 @@ def _resume_command(target: str, fp: dict) -> str | None:
             cfg["initial.quaternion"] = ",".join(_num(v) for v in fp["q0"])
             flags += ["--quaternion", cfg["initial.quaternion"]]
         flags += ["--t-end", _num(t_end), "--samples", str(int(samples))]
-        keys = {
-            "gravity": (("torque.center_of_mass", "center_of_mass"), ("torque.mass", "mass"), ("torque.gravity", "g")),
-            "gravity_gradient": (("torque.gravity_gradient", "mean_motion"),),
-            "body_torque": (("torque.body_torque", "tau"),),
-            "space_torque": (("torque.space_torque", "tau"),),
-        }
+        from ..model.torques import TORQUES
+
+        # the flags of every registered torque, from its own description (a torque without flags cannot be resumed
+        # by a command)
+        keys = {kind: tuple((f"torque.{p.toml_key}", p.name) for p in cls.cli) for kind, cls in TORQUES.items()}
         for rec in fp.get("torque", []):
+            if not keys.get(rec.get("kind")):
+                return None
             for key, field in keys[rec["kind"]]:
                 v = rec[field]
                 cfg[key] = ",".join(_num(x) for x in v) if isinstance(v, list) else _num(v)
                 flags += [FLAGS[key], cfg[key]]
         model = Model(build_body(cfg), build_torques(cfg))
         method = fp["method"]
-        if method != ("exact" if model.is_free else "taylor"):
+        from ..solvers.engine import default_method
+
+        if method != default_method(model):
             flags += ["--method", method]
         cls = get_method(method)
 

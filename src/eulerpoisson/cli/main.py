@@ -32,7 +32,9 @@ def cmd_demo(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from .. import __version__
+    from ..version import package_version
+
+    __version__ = package_version()
 
     p = Parser(
         prog="eulerpoisson",

@@ -25,7 +25,7 @@ from .config import (
     pair,
 )
 
-__all__ = ["add_commands", "cmd_simulate", "MAX_SAMPLES", "CHUNKED_SAMPLES", "LONG_RUN_STEPS", "CHUNKS"]
+__all__ = ["add_commands", "cmd_simulate", "solve_run", "MAX_SAMPLES", "CHUNKED_SAMPLES"]
 
 
 #: most output times of one run (a float64 time axis has 2**53 distinct integers; far beyond any disk)
@@ -71,98 +71,72 @@ def _state_json(traj, drift) -> dict:
     }
 
 
-#: output samples above which ``simulate`` works in chunks (and shows a progress bar on a terminal)
+#: output samples above which ``simulate`` shows a progress bar on a terminal (the run is solved by the engine's
+#: segments, :mod:`eulerpoisson.solvers.engine`, the same in every route)
 CHUNKED_SAMPLES = 5000
 
-#: a stepping method expected to take more steps than this runs in chunks with a progress bar, whatever the samples
-LONG_RUN_STEPS = 100_000
-CHUNKS = 50
 
+def solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, keep: bool = True):
+    """The run of ``simulate`` in memory: the one engine's segments, with a progress bar on a terminal.
 
-def _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep: bool = True):
-    """``solve`` over increasing output times, in chunks, with a progress bar on a terminal.
+    The segments are those of every other route (:func:`eulerpoisson.solve`, a Zarr store, a sweep), so
+    ``simulate`` gives the same bits whether it writes a NetCDF file, a Zarr store or nothing.
 
-    The chunking depends only on the number of samples (never on whether a
-    terminal is attached), so a run gives the same numbers everywhere. The
-    closed form evaluates every chunk from the initial state (identical to one
-    call); stepping methods continue each chunk from the last state of the
-    previous one, as :func:`eulerpoisson.io.stream.solve_to_file` does.
-
-    ``keep=False`` (nothing is written): only the first and the last sample
-    are kept and the drift of the integrals is accumulated chunk by chunk,
-    so memory does not grow with the samples; returns ``(trajectory of those
-    two samples, drift)``.
+    ``keep=False`` (nothing is written): only the first and the last sample are kept and the drift of the
+    integrals is accumulated segment by segment, so memory does not grow with the samples; returns
+    ``(trajectory of those two samples, drift)``.
     """
-    from ..io.stream import ProgressDisplay, solve_from
+    from ..io.stream import ProgressDisplay
     from ..model.drift import DriftAccumulator
-    from ..solvers import get_method, solve
+    from ..solvers.engine import TimeGrid, collect, merge_stats, prepare_run
     from ..trajectory import Trajectory
 
-    closed_form = get_method(method).order is None
-    long_run = False
-    if not closed_form and omega0 is not None and t.size > 2:
-        # a stepping method turns the body by a few radians per step at most: a long run shows progress too
-        rate = float(np.max(np.linalg.norm(np.atleast_2d(omega0), axis=-1)))
-        long_run = rate * float(np.max(np.abs(t))) / (8 * np.pi) > LONG_RUN_STEPS
-    if t.size < CHUNKED_SAMPLES and not long_run:
-        tr = solve(model, t, omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
-        return tr if keep else (tr, tr.drift())
+    run = prepare_run(
+        model,
+        TimeGrid(0.0, t_end, samples),
+        omega0=omega0,
+        m0=m0,
+        attitude0=q0,
+        method=method,
+        in_memory=keep,
+        caller="simulate",
+        **opts,
+    )
+    show = progress if (samples >= CHUNKED_SAMPLES or len(run.bounds) > 1) else False
+    start = time.perf_counter()
+    pieces: list = []  # the segments (keep) or their counters
     acc = None if keep else DriftAccumulator(model)
-    pieces = [p for p in np.array_split(np.arange(t.size), min(CHUNKS, t.size)) if p.size]
-    qs: list[np.ndarray] = []
-    ws: list[np.ndarray] = []
-    wall = 0.0
-    first = None
-    qs_end_index = 0  # the last output time of the previous chunk (a stepping method continues from it)
-    from ..util.jit import whole_run
-
-    # one choice of compiled kernels or NumPy for the whole run, not per chunk (the same numbers as one call)
-    with ProgressDisplay(progress, t.size, f"{method}: solving") as bar, whole_run(n_times=t.size):
-        done = 0
-        for idx in pieces:
-            if closed_form or first is None:
-                tr = solve(model, t[idx], omega0=omega0, m0=m0, attitude0=q0, method=method, **opts)
+    first = last = None
+    with ProgressDisplay(show, samples, f"{run.method_name}: solving") as bar:
+        for seg in run.segments():
+            tr = seg.trajectory
+            if acc is None:
+                pieces.append(seg)
             else:
-                # the time-dependent torques are shifted to the chunk's start (solve_from)
-                tr = solve_from(
-                    model, t[idx], t[qs_end_index], qs[-1][..., -1, :], ws[-1][..., -1, :], method=method, **opts
-                )
-            first = tr if first is None else first
-            if acc is not None:
                 acc.update(tr.t, tr.quaternion, tr.omega)
-                if len(qs) > 1:  # keep the first chunk's first sample and the last chunk only
-                    qs.pop()
-                    ws.pop()
-            qs.append(tr.quaternion if acc is None or not qs else tr.quaternion[..., -1:, :])
-            ws.append(tr.omega if acc is None or not ws else tr.omega[..., -1:, :])
-            qs_end_index = idx[-1]
-            wall += tr.stats.get("wall_time", 0.0)
-            done += idx.size
-            bar.update(done)
-    assert first is not None  # there is at least one piece
-    stats = dict(first.stats, wall_time=wall, chunks=len(pieces))
-    if acc is not None:
-        ends = Trajectory(
-            t[[0, -1]],
-            np.concatenate([qs[0][..., :1, :], qs[-1][..., -1:, :]], axis=-2),
-            np.concatenate([ws[0][..., :1, :], ws[-1][..., -1:, :]], axis=-2),
-            first.body,
-            method,
-            first.options,
-            stats,
-            torque=list(model.torques),
-        )
-        return ends, acc.result()
-    return Trajectory(
-        t,
-        np.concatenate(qs, axis=-2),
-        np.concatenate(ws, axis=-2),
+                first = tr[[0]] if first is None else first
+                last = tr[[-1]]
+                pieces.append(seg.trajectory.stats)
+            bar.update(seg.stop)
+    if acc is None:
+        return collect(run, pieces)
+    assert first is not None and last is not None  # at least one sample
+    stats = merge_stats(run.method, pieces)
+    if len(pieces) > 1:
+        stats["segments"] = len(pieces)
+    stats["wall_time"] = time.perf_counter() - start
+    ends = Trajectory(
+        np.concatenate([first.t, last.t]),
+        np.concatenate([first.quaternion, last.quaternion], axis=-2),
+        np.concatenate([first.omega, last.omega], axis=-2),
         first.body,
-        method,
-        first.options,
+        run.method_name,
+        run.options,
         stats,
         torque=list(model.torques),
+        keep_signs=True,  # the signs of the whole run at its two ends
     )
+    return ends, acc.result()
 
 
 def cmd_simulate(args) -> int:
@@ -200,12 +174,8 @@ def cmd_simulate(args) -> int:
             ("allow_unphysical", "body.allow_unphysical"),
             *((opt, f"method.{opt}") for opt in METHOD_OPTIONS),
             ("out", "output.file"),
-            ("gravity", "torque.gravity"),
-            ("mass", "torque.mass"),
-            ("com", "torque.center_of_mass"),
-            ("gravity_gradient", "torque.gravity_gradient"),
-            ("body_torque", "torque.body_torque"),
-            ("space_torque", "torque.space_torque"),
+            # the torque flags of the registered torques (add_commands: dest = the flag without "--", "-" -> "_")
+            *((FLAGS[key][2:].replace("-", "_"), key) for key in FLAGS if key.startswith("torque.")),
             ("workers", "compute.workers"),
         )
         if getattr(args, attr, None) is not None
@@ -294,8 +264,10 @@ def cmd_simulate(args) -> int:
             )
     torques = build_torques(cfg, name)
     model = Model(body, torques)
-    # the closed form runs the free body (and the Lagrange top); under a torque the default is taylor
-    method = cfg.get("method.name", "exact" if model.is_free else "taylor")
+    # one rule with ep.solve: the most accurate method that can run the model (exact, else taylor, ...)
+    from ..solvers.engine import default_method
+
+    method = cfg.get("method.name") or default_method(model)
     if method not in available_methods():
         raise UsageError(
             f"{name('method.name')}: unknown method {method!r}; available: {', '.join(available_methods())}"
@@ -308,9 +280,10 @@ def cmd_simulate(args) -> int:
             workers = int(str(workers).strip())
         except ValueError:
             workers = 0
-        if workers < 1:
+        if workers < 1 and workers != -1:
             raise UsageError(
-                f"{name('compute.workers')} must be a whole number of threads >= 1, got {cfg['compute.workers']!r}"
+                f"{name('compute.workers')} must be a whole number of threads >= 1 (-1: every core), "
+                f"got {cfg['compute.workers']!r}"
             )
         opts["workers"] = workers  # a keyword of solve, solve_from and solve_to_file, not a method option
     out = cfg.get("output.file")
@@ -371,11 +344,10 @@ def cmd_simulate(args) -> int:
         traj = store[[0, len(store) - 1]]
         traj.stats["wall_time"] = time.perf_counter() - start
     else:
-        t = np.linspace(0.0, t_end, samples)
         if out is None:  # nothing is written: keep the ends and the drift only (bounded memory)
-            traj, drift = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress, keep=False)
+            traj, drift = solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, keep=False)
         else:
-            traj = _solve_in_chunks(model, t, omega0, m0, q0, method, opts, progress)
+            traj = solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress)
             with OutputLock(out):
                 traj.to_netcdf(out)
     if out is not None:
@@ -399,6 +371,9 @@ def cmd_simulate(args) -> int:
 def add_commands(sub) -> None:
     """Register ``simulate`` on the subcommand parser ``sub``."""
     from ..solvers import available_methods, get_method
+    from .config import sync_torque_keys, torque_params, torque_toml_keys
+
+    sync_torque_keys()  # torques registered since the import of the configuration get their flags and keys
 
     ex = argparse.RawDescriptionHelpFormatter
     s = sub.add_parser(
@@ -420,7 +395,7 @@ def add_commands(sub) -> None:
             "  [initial] omega=[...] | m=[...]; quaternion=[w,x,y,z] | gibbs=[...]\n"
             "  [time] t_end, samples   [method] name, tol, dt, scheme, order, integrator, rtol, atol\n"
             "  [output] file, json\n"
-            "  [torque] center_of_mass=[...], mass, gravity=[...]; gravity_gradient; body_torque=[...]; space_torque=[...]\n\n"
+            f"  [torque] {torque_toml_keys()}\n\n"
             "Torques: a heavy top is --com (centre of mass, body frame, from the fixed point; the inertia is about\n"
             "the fixed point) with --mass (default 1) and --gravity (default 0,0,-9.81); --gravity-gradient NU is a\n"
             "circular orbit of mean motion NU; --body-torque / --space-torque are constant torques. They add up.\n"
@@ -452,25 +427,8 @@ def add_commands(sub) -> None:
         s.add_argument(
             "--" + opt.replace("_", "-"), dest=opt, metavar=opt.upper(), help=f"method option {opt} ({owners})"
         )
-    s.add_argument(
-        "--com",
-        metavar="CX,CY,CZ",
-        help="heavy top: centre of mass in the body frame, from the fixed point (the inertia is about it)",
-    )
-    s.add_argument("--mass", metavar="M", help="heavy top: mass M > 0 (default 1; needs --com)")
-    s.add_argument(
-        "--gravity",
-        metavar="GX,GY,GZ",
-        help="heavy top: gravitational acceleration, space frame (default 0,0,-9.81; needs --com)",
-    )
-    s.add_argument(
-        "--gravity-gradient",
-        dest="gravity_gradient",
-        metavar="NU",
-        help="gravity-gradient torque of a circular orbit with mean motion NU >= 0 (rad per time unit)",
-    )
-    s.add_argument("--body-torque", dest="body_torque", metavar="TX,TY,TZ", help="constant torque in the body frame")
-    s.add_argument("--space-torque", dest="space_torque", metavar="TX,TY,TZ", help="constant torque in the space frame")
+    for _, p in torque_params():  # every parameter of every registered torque (Torque.cli), in the registry's order
+        s.add_argument(p.flag, dest=p.flag[2:].replace("-", "_"), metavar=p.metavar, help=p.help)
     s.add_argument("--out", help="write the trajectory to this NetCDF (.nc) file or stream it to a Zarr (.zarr) store")
     s.add_argument(
         "--json",
@@ -487,7 +445,7 @@ def add_commands(sub) -> None:
         "--workers",
         metavar="N",
         help="threads that solve a batch of bodies (default: $EULERPOISSON_WORKERS, else every core; "
-        "1: one thread); the results do not depend on it",
+        "1: one thread; -1: every core); the results do not depend on it",
     )
     s.add_argument("--quiet", action="store_true", help="print nothing but errors")
     s.set_defaults(func=cmd_simulate)

@@ -26,30 +26,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..attitude.core import Attitude, quaternion_from_scipy
-from ..errors import InvalidInputError
+from ..errors import FitInputError, InvalidInputError
 from ..util.validate import as_float_array
 
 __all__ = ["ObservationSet", "observation_set", "quaternion_array", "FitInputError"]
 
 #: norm tolerance of observed unit quaternions and directions (as everywhere in the package)
 UNIT_TOL = 1e-6
-
-
-class FitInputError(InvalidInputError):
-    """Observations or options that a fit cannot use (a ValueError).
-
-    Examples
-    --------
-    >>> import numpy as np, eulerpoisson as ep
-    >>> from eulerpoisson.estimation import FitInputError
-    >>> try:
-    ...     ep.fit([0.0, 1.0, 2.0])                                    # no observations at all
-    ... except FitInputError as err:
-    ...     print(err)
-    no observations: give attitude, omega or axis_direction (rows of NaN are missing ones)
-    >>> issubclass(FitInputError, ValueError)
-    True
-    """
 
 
 @dataclass(frozen=True)

@@ -601,7 +601,7 @@ def _read_csv(p: Path, shown: str) -> _Raw:
 
 def _read_netcdf(p: Path, shown: str) -> _Raw:
     xr = require("xarray", "io")
-    from .read import netcdf_engine
+    from .formats import netcdf_engine
 
     try:
         ds = xr.load_dataset(p, engine=netcdf_engine(p), decode_times=False, decode_timedelta=False)

@@ -25,7 +25,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..errors import EulerPoissonError
+from ..errors import OutputError
 
 __all__ = ["OutputError", "file_kind", "check_output", "OutputLock", "KINDS"]
 
@@ -34,10 +34,6 @@ KINDS = ("netcdf", "trajectory-store", "sweep-store", "file")
 
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 _CDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
-
-
-class OutputError(EulerPoissonError, FileExistsError):
-    """An output that may not be written: it exists (no overwrite), is an input, is of another kind, or is locked."""
 
 
 def file_kind(path: str | os.PathLike[str]) -> str | None:

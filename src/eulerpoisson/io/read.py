@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import EulerPoissonError, InvalidInputError, require
+from .formats import HDF5_MAGIC, NETCDF3_MAGIC, file_format, is_zarr_store
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -57,39 +58,8 @@ if TYPE_CHECKING:
 
 __all__ = ["open_trajectory", "LazyTrajectory", "StoredArray", "file_format", "NETCDF3_MAGIC", "HDF5_MAGIC"]
 
-#: first bytes of a NetCDF-3 file (classic, 64-bit offset, 64-bit data)
-NETCDF3_MAGIC = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
-#: first bytes of an HDF5 file (NetCDF-4)
-HDF5_MAGIC = b"\x89HDF\r\n\x1a\n"
-
 #: stores of at most this many samples are loaded into memory by ``LazyTrajectory.load()`` without asking
 LOAD_LIMIT = 20_000_000
-
-
-def _is_zarr_store(path: Path) -> bool:
-    return path.is_dir() and any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zattrs"))
-
-
-def file_format(path: str | os.PathLike[str]) -> str:
-    """The format of a trajectory file by its content: ``"zarr"``, ``"netcdf4"``, ``"netcdf3"`` or ``"unknown"``."""
-    p = Path(os.fsdecode(path))
-    if p.is_dir():
-        return "zarr" if _is_zarr_store(p) else "unknown"
-    try:
-        with open(p, "rb") as fh:
-            head = fh.read(8)
-    except OSError:
-        return "unknown"
-    if head.startswith(HDF5_MAGIC):
-        return "netcdf4"
-    if head[:4] in NETCDF3_MAGIC:
-        return "netcdf3"
-    return "unknown"
-
-
-def netcdf_engine(path) -> str:
-    """xarray's engine for a NetCDF file: ``"scipy"`` for NetCDF-3, ``"h5netcdf"`` otherwise."""
-    return "scipy" if file_format(path) == "netcdf3" else "h5netcdf"
 
 
 def open_trajectory(path: str | os.PathLike[str]) -> Trajectory | LazyTrajectory:
@@ -131,7 +101,7 @@ def open_trajectory(path: str | os.PathLike[str]) -> Trajectory | LazyTrajectory
     if not p.exists():
         raise FileNotFoundError(f"no such file: {path}")
     if p.is_dir():
-        if not _is_zarr_store(p):
+        if not is_zarr_store(p):
             raise EulerPoissonError(
                 f"{path} is a folder but not a Zarr store (a trajectory is a NetCDF file or a .zarr store "
                 "written by 'eulerpoisson simulate --out')"
@@ -536,7 +506,8 @@ class LazyTrajectory:
     def __init__(self, path: str | os.PathLike[str]) -> None:
         from ..model.body import RigidBody
         from ..model.equations import Model
-        from ..trajectory import FORMAT_VERSION, format_version, json_attr, read_torques
+        from ..trajectory import FORMAT_VERSION
+        from .netcdf import format_version, json_attr, read_torques
 
         self.path = Path(path)
         g = zarr_group(self.path)
@@ -792,6 +763,7 @@ class LazyTrajectory:
             self.options,
             self.stats,
             torque=list(self.model.torques),
+            keep_signs=True,  # the stored signs (continuous over the whole run): a selection never flips one
         )
 
     def head(self, n: int = 1) -> Trajectory:
@@ -847,6 +819,7 @@ class LazyTrajectory:
             self.body,
             self.method,
             torque=list(self.model.torques),
+            keep_signs=True,
         )
         return both.drift()
 

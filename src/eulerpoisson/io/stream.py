@@ -30,27 +30,22 @@ Output times
   chunk at a time, so it may itself live on disk. Only a *tuple* of three
   numbers is read as ``(t0, t1, n)``; a list or an array is a list of times.
 
-Closed-form and stepping methods
---------------------------------
-For a closed-form method (a registered method whose ``order`` is ``None``,
-i.e. ``"exact"``) every chunk is solved independently from the initial
-state at :math:`t=0`, so the output is *identical* to a single
-:func:`~eulerpoisson.solve` call on all the times (the closed form
-costs O(1) per time and has no state to carry).
-
-For a stepping method (``"rk"``, ``"taylor"``, ``"symplectic"``, ...) the
-times must be strictly monotonic and chunk :math:`k>0` is solved from the
-last state of chunk :math:`k-1`: with :math:`\tau_k` that last time and
-:math:`(q, \boldsymbol\Omega)` the state there,
-``solve(body, t_chunk - tau_k, attitude0=q, omega0=Omega)`` (the free body,
-and a body under time-independent torques, is autonomous, so shifting time
-is exact; a time-dependent torque is shifted with it, see
-:func:`solve_from`). The result is *consistent* —
-the same integrator at the same settings, restarted at the chunk
-boundaries — but not bitwise equal to one long integration: an adaptive
-step-size controller restarts at each boundary and a fixed-step method
-re-aligns its steps there. The difference is of the order of the method's
-own error.
+The same bits as :func:`~eulerpoisson.solve`
+---------------------------------------------
+The run is solved by the one engine (:mod:`eulerpoisson.solvers.engine`),
+segment by segment, exactly as :func:`~eulerpoisson.solve`, ``simulate``
+and the sweeps solve it: the store holds the same bits as ``solve`` on the
+same times, whatever its storage ``chunk`` (tested for every method,
+``tests/test_routes.py``). A closed-form method (``"exact"``) evaluates
+every time from the initial state at :math:`t=0`. A stepping method
+(``"rk"``, ``"taylor"``, ``"symplectic"``, ...) needs strictly monotonic
+times; the engine cuts a long run into segments (of at most
+:data:`~eulerpoisson.solvers.engine.SEGMENT` output times, a function of
+the run alone) and continues each segment from the last state of the
+previous one (the free body, and a body under time-independent torques, is
+autonomous, so shifting time is exact; a time-dependent torque is shifted
+with it, :meth:`~eulerpoisson.Model.shifted`). The storage chunks only
+decide what is written and marked at a time.
 
 Atomic output, interruption and resuming
 ----------------------------------------
@@ -67,7 +62,8 @@ its data, so on Ctrl-C (or a crash, or a kill) nothing finished is lost:
   are the same (a fingerprint of body, initial state, times, method,
   options, chunk and variables is kept in ``.NAME.partial/state.json``) and
   computes only the missing chunks; a stepping method continues from the
-  last stored state. Without ``resume=True`` a leftover partial store is an
+  stored state that ends the segment before them (the segment is computed
+  again from its start, so the bits are those of an uninterrupted run). Without ``resume=True`` a leftover partial store is an
   error (pass ``overwrite=True`` to discard it and start again);
   ``resume=True`` with no partial store simply starts the run. A work
   folder whose ``state.json`` is missing (interrupted while the empty store
@@ -97,19 +93,22 @@ import hashlib
 import json
 import numbers
 import os
-import shutil
 import sys
-import time as _time
 import warnings
 from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, overload
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-from ..errors import EulerPoissonError, InvalidInputError, require
+from ..errors import InvalidInputError, require
+from ..solvers.engine import TimeGrid, as_time_source, read_times
+from .resumable import (
+    PartialRun,
+    partial_store,
+)
 
 if TYPE_CHECKING:
     from ..attitude.core import AttitudeLike
@@ -129,121 +128,12 @@ _STATE_VERSION = 1
 # ---------------------------------------------------------------------------
 # output times
 # ---------------------------------------------------------------------------
-class TimeGrid:
-    r"""``n`` equally spaced times from ``t0`` to ``t1`` (inclusive), generated on demand.
-
-    Behaves as a read-only 1-D float64 sequence: ``len(grid)`` and
-    ``grid[a:b]`` (an ndarray computed on the fly, equal bit for bit to
-    ``numpy.linspace(t0, t1, n)[a:b]``). Nothing of size ``n`` is ever
-    allocated.
-
-    Parameters
-    ----------
-    t0, t1 : float
-        First and last time (finite; ``t1 < t0`` runs backwards).
-    n : int
-        Number of times, >= 1.
-
-    Raises
-    ------
-    InvalidInputError
-        Non-finite ``t0``/``t1`` or ``n < 1``.
-    TypeError
-        Non-numeric arguments or a non-integer ``n``.
-
-    Examples
-    --------
-    >>> g = TimeGrid(0.0, 1.0, 5)
-    >>> len(g), g[1:3].tolist()
-    (5, [0.25, 0.5])
-    """
-
-    def __init__(self, t0, t1, n) -> None:  # float, float, int: anything else is refused below
-        for name, v in (("t0", t0), ("t1", t1)):
-            if isinstance(v, bool) or not isinstance(v, numbers.Real):
-                raise TypeError(f"t: {name} must be a real number, got {type(v).__name__} {v!r}")
-            if not np.isfinite(v):  # type: ignore[call-overload]  # mypy types no numbers.Real as a float
-                raise InvalidInputError(f"t: {name} must be finite, got {v!r}")
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral):
-            if isinstance(n, numbers.Real) and float(n) == int(n):  # type: ignore[call-overload]
-                n = int(n)  # type: ignore[call-overload]
-            else:
-                raise TypeError(f"t: the number of samples n must be an integer, got {n!r}")
-        if n < 1:
-            raise InvalidInputError(f"t: the number of samples n must be >= 1, got {n}")
-        self.t0, self.t1, self.n = float(t0), float(t1), int(n)
-        div = self.n - 1
-        self._delta = self.t1 - self.t0
-        self._step = self._delta / div if div > 0 else np.nan
-
-    def __len__(self) -> int:
-        return self.n
-
-    @property
-    def shape(self) -> tuple[int]:
-        return (self.n,)
-
-    @overload
-    def __getitem__(self, idx: slice) -> NDArray[np.float64]: ...
-    @overload
-    def __getitem__(self, idx: int | np.integer) -> float: ...
-    @overload
-    def __getitem__(self, idx: ArrayLike) -> float | NDArray[np.float64]: ...
-    def __getitem__(self, idx: int | slice | ArrayLike) -> float | NDArray[np.float64]:
-        if isinstance(idx, slice):
-            a, b, s = idx.indices(self.n)
-            i = np.arange(a, b, s, dtype=np.float64)
-        else:
-            i = np.asarray(idx)
-            if not np.issubdtype(i.dtype, np.integer):
-                raise TypeError(f"TimeGrid indices must be integers or slices, got {idx!r}")
-            i = np.where(i < 0, i + self.n, i)
-            if np.any((i < 0) | (i >= self.n)):
-                raise IndexError(f"TimeGrid index out of range for n = {self.n}")
-            i = i.astype(np.float64)
-        if self.n == 1:
-            y = i * self._delta
-        elif self._step == 0:  # denormal step, as numpy.linspace
-            y = i / (self.n - 1) * self._delta
-        else:
-            y = i * self._step
-        y = y + self.t0
-        if self.n > 1:
-            y = np.where(i == self.n - 1, self.t1, y)
-        return y if y.ndim else float(y)
-
-    def __repr__(self) -> str:
-        return f"TimeGrid({self.t0!r}, {self.t1!r}, {self.n})"
-
-
 def _as_time_source(t):
-    if isinstance(t, TimeGrid):
-        return t
-    if isinstance(t, tuple):
-        if len(t) != 3:
-            raise InvalidInputError(
-                f"t: a tuple is read as (t0, t1, n), got a tuple of length {len(t)}; "
-                "pass a list or an array for explicit times"
-            )
-        return TimeGrid(*t)
-    if isinstance(t, (str, bytes)):
-        raise TypeError(f"t must be (t0, t1, n), a TimeGrid or a 1-D array of times, got the string {t!r}")
-    if isinstance(t, (list, numbers.Real)) or not hasattr(t, "__getitem__"):
-        t = np.atleast_1d(np.asarray(t))
-    shape = getattr(t, "shape", None)
-    if shape is None:
-        shape = (len(t),)
-    if len(shape) != 1:
-        raise InvalidInputError(f"t must be a 1-D array of output times, got shape {tuple(shape)}")
-    if shape[0] < 1:
-        raise InvalidInputError("t is empty: give at least one output time")
-    return t
+    return as_time_source(t)
 
 
 def _read_times(src, a: int, b: int) -> np.ndarray:
-    from ..util.validate import as_float_array
-
-    return as_float_array(np.asarray(src[a:b]), f"t[{a}:{b}]").reshape(-1)
+    return read_times(src, a, b)
 
 
 def _times_fingerprint(src, chunk: int) -> dict:
@@ -315,10 +205,6 @@ class ProgressDisplay:
 # ---------------------------------------------------------------------------
 # work folder
 # ---------------------------------------------------------------------------
-def work_dir(path: Path) -> Path:
-    return path.with_name(f".{path.name}.partial")
-
-
 def _finished_run(path: Path):
     """The arguments recorded in a finished store (None if there are none or it is not a store of ours)."""
     try:
@@ -329,63 +215,6 @@ def _finished_run(path: Path):
         return json.loads(raw) if isinstance(raw, str) else None
     except Exception:  # noqa: BLE001 - anything unreadable is "not a finished run of ours"
         return None
-
-
-def partial_store(path: str | os.PathLike[str]) -> Path:
-    """The Zarr store where :func:`solve_to_file` keeps the chunks of an unfinished run to ``path``.
-
-    Readable while the run is going on or after it was interrupted
-    (``xarray.open_zarr(partial_store(path))``); unfinished samples read as NaN.
-    """
-    return work_dir(Path(path)) / "store.zarr"
-
-
-def write_json_atomic(path: Path, obj) -> None:
-    from .atomic import atomic_write_text
-
-    atomic_write_text(path, json.dumps(obj, sort_keys=True, indent=1))
-
-
-def mark_done(work: Path, k: int, info: dict) -> None:
-    write_json_atomic(work / "done" / f"{k:09d}", info)
-
-
-def done_chunks(work: Path) -> set[int]:
-    d = work / "done"
-    if not d.is_dir():
-        return set()
-    return {int(p.name) for p in d.iterdir() if p.name.isdigit()}
-
-
-def _is_zarr_store(path: Path) -> bool:
-    """True for a folder holding a Zarr group or array (format 2 or 3 metadata at its top)."""
-    return any((path / name).is_file() for name in ("zarr.json", ".zgroup", ".zarray"))
-
-
-def check_replaceable(dest: Path) -> None:
-    """FileExistsError when ``dest`` is a folder that is not a Zarr store (``overwrite`` must not delete it)."""
-    if dest.is_dir() and not dest.is_symlink() and not _is_zarr_store(dest):
-        raise FileExistsError(
-            f"refusing to replace {dest}: it is a folder but not a Zarr store (overwrite only replaces "
-            f"earlier results); remove it yourself or choose another path"
-        )
-
-
-def replace_dir(src: Path, dest: Path, overwrite: bool) -> None:
-    """Move folder ``src`` to ``dest``; an existing ``dest`` is replaced only with ``overwrite``."""
-    if dest.exists() or dest.is_symlink():
-        if not overwrite:
-            raise FileExistsError(f"{dest} exists; pass overwrite=True to replace it")
-        check_replaceable(dest)
-        trash = dest.with_name(f".{dest.name}.old-{os.getpid()}")
-        os.replace(dest, trash)
-        os.replace(src, dest)
-        if trash.is_dir() and not trash.is_symlink():
-            shutil.rmtree(trash, ignore_errors=True)
-        else:
-            trash.unlink(missing_ok=True)
-    else:
-        os.replace(src, dest)
 
 
 @contextlib.contextmanager
@@ -401,80 +230,6 @@ def quiet_zarr():
 # ---------------------------------------------------------------------------
 # continuing a solution from a later state (chunks)
 # ---------------------------------------------------------------------------
-def _rotation_z(phi) -> np.ndarray:
-    """Quaternions (..., 4) of the rotations by ``phi`` about the space z axis."""
-    phi = np.asarray(phi, dtype=float)
-    return np.stack([np.cos(phi / 2), np.zeros_like(phi), np.zeros_like(phi), np.sin(phi / 2)], -1)
-
-
-def _rotate_z(v, phi) -> np.ndarray:
-    """Space vectors ``v`` (..., 3) rotated by ``phi`` (...) about z."""
-    v = np.asarray(v, dtype=float)
-    c, s = np.cos(phi), np.sin(phi)
-    return np.stack(
-        [
-            c * v[..., 0] - s * v[..., 1],
-            s * v[..., 0] + c * v[..., 1],
-            np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, np.shape(c))),
-        ],
-        -1,
-    )
-
-
-def _shifted_torques(torques, t_start: float):
-    r"""The torques seen from time ``t_start`` on: ``(torques', phi)``.
-
-    With :math:`s = t - t_\mathrm{start}`, the motion under ``torques'``
-    from the state at ``t_start`` rotated by :math:`R_z(-\varphi)` is the
-    original motion, rotated by :math:`R_z(-\varphi)` in space. A gravity
-    gradient of mean motion :math:`\nu` is the same torque in the space frame
-    turned by :math:`\varphi = \nu t_\mathrm{start}` (its orbit direction is
-    :math:`\hat{\mathbf r}(t_\mathrm{start} + s) = R_z(\varphi)\hat{\mathbf r}(s)`),
-    so space-fixed vectors of the other torques (gravity, a space-frame torque)
-    are turned by :math:`-\varphi`; a Python function is called at the shifted
-    time with the attitude turned back. Body-frame torques are unchanged.
-
-    Raises
-    ------
-    InvalidInputError
-        A time-dependent torque of a class that cannot be shifted.
-    """
-    from ..model.torques import BodyTorque, CallableTorque, Gravity, GravityGradient, SpaceTorque, Torque
-    from ..numerics.quaternion import qmul
-
-    grads = [tq for tq in torques if isinstance(tq, GravityGradient)]
-    phi = np.zeros(())
-    for tq in grads:
-        if np.any(tq.mean_motion != 0):
-            phi = np.asarray(tq.mean_motion, dtype=float) * t_start
-            break
-    turn = bool(np.any(phi != 0))
-    out: list[Torque] = []
-    for tq in torques:
-        if isinstance(tq, (GravityGradient, BodyTorque)):
-            out.append(tq)
-        elif isinstance(tq, Gravity):
-            out.append(Gravity(tq.mass, tq.center_of_mass, _rotate_z(tq.g, -phi)) if turn else tq)
-        elif isinstance(tq, SpaceTorque):
-            out.append(SpaceTorque(_rotate_z(tq.tau, -phi)) if turn else tq)
-        elif isinstance(tq, CallableTorque):
-            func, rz = tq.func, _rotation_z(phi)
-
-            def shifted(s, q, omega, _f=func, _rz=rz, _turn=turn):
-                return _f(np.asarray(s) + t_start, qmul(_rz, q) if _turn else q, omega)
-
-            shifted.__name__ = getattr(func, "__name__", "torque")
-            out.append(CallableTorque(shifted))
-        elif tq.time_dependent or turn:
-            raise InvalidInputError(
-                f"the torque {tq!r} depends on time (or on the space frame with a gravity gradient) and "
-                "cannot be continued from a later state; solve the run in one piece"
-            )
-        else:
-            out.append(tq)
-    return out, phi
-
-
 def solve_from(
     model: Model | RigidBody | ArrayLike,
     t: ArrayLike,
@@ -493,7 +248,7 @@ def solve_from(
     ``solve(model, t - t_start, attitude0=q_start, omega0=omega_start)``
     continues the motion; time-dependent torques (a gravity gradient, a
     Python function) are shifted by ``t_start`` so that the result is the same
-    motion (see :func:`_shifted_torques`).
+    motion (see :meth:`~eulerpoisson.Model.shifted`).
 
     Parameters
     ----------
@@ -516,37 +271,15 @@ def solve_from(
         At the absolute times ``t``, with the original model (so that the
         energy, the integrals and the drift are those of the motion).
     """
-    from ..model.equations import Model, as_model
-    from ..numerics.quaternion import qmul
-    from ..solvers import solve
-    from ..trajectory import Trajectory
+    from ..model.equations import as_model
+    from ..solvers.engine import continue_from, prepare_run
 
     model = as_model(model)
-    t = np.asarray(t, dtype=float)
-    t_start = float(t_start)
-    if model.is_autonomous or t_start == 0.0:
-        tr = solve(model, t - t_start, omega0=omega_start, attitude0=q_start, method=method, workers=workers, **options)
-        tr.t = t
-        return tr
-    torques, phi = _shifted_torques(model.torques, t_start)
-    q_start = np.asarray(q_start, dtype=float)
-    turned = bool(np.any(phi != 0))
-    if turned:
-        rz = _rotation_z(phi)
-        q_start = qmul(rz * np.array([1.0, -1.0, -1.0, -1.0]), q_start)
-    tr = solve(
-        Model(model.body, torques),
-        t - t_start,
-        omega0=omega_start,
-        attitude0=q_start,
-        method=method,
-        workers=workers,
-        **options,
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    run = prepare_run(
+        model, t, omega0=omega_start, attitude0=q_start, method=method, workers=workers, in_memory=True, **options
     )
-    q = tr.quaternion
-    if turned:
-        q = qmul(_rotation_z(phi)[..., None, :], q)
-    return Trajectory(t, q, tr.omega, model.body, tr.method, tr.options, tr.stats, torque=list(model.torques))
+    return continue_from(run, t, float(t_start), run.problem.q0, run.problem.omega0)
 
 
 def torque_fingerprint(model) -> list:
@@ -562,6 +295,10 @@ def torque_fingerprint(model) -> list:
 # ---------------------------------------------------------------------------
 # the streaming solver
 # ---------------------------------------------------------------------------
+#: the variables with a trailing component axis (the others are scalars at each time)
+_VECTORS = ("quaternion", "omega", "M", "m", "gibbs")
+
+
 def _chunk_arrays(traj, variables) -> dict[str, np.ndarray]:
     out = {"quaternion": traj.quaternion, "omega": traj.omega}
     for name in variables:
@@ -677,9 +414,7 @@ def solve_to_file(
     sample; quaternion signs are made continuous across chunk boundaries
     (as :class:`~eulerpoisson.trajectory.Trajectory` does within one).
     """
-    from ..solvers import get_method, make_problem, solve
-    from ..solvers.parallel import check_workers
-    from ..solvers.registry import check_supported
+    from ..solvers.engine import prepare_run
     from ..trajectory import Trajectory
     from ..util.validate import as_scalar
 
@@ -703,25 +438,30 @@ def solve_to_file(
     if progress is not None and not isinstance(progress, bool) and not callable(progress):
         raise TypeError(f"progress must be None, True, False or a callable(done, total), got {progress!r}")
 
-    cls = get_method(method)
-    meth = cls(**options)  # validates the options
-    check_workers(workers)
-    closed_form = cls.order is None
-    src = _as_time_source(t)
-    n = len(src)
-    t_first = _read_times(src, 0, 1)
-    problem = make_problem(body, t_first, omega0=omega0, m0=m0, attitude0=attitude0, torque=torque)
-    check_supported(method, problem.model)
-    model = problem.model
-    if not cls.negative_times and np.any(t_first < 0):
-        raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
+    src = as_time_source(t)
+    # the one engine (solvers.engine): checks, the method planned for the whole run, its segments
+    run = prepare_run(
+        body,
+        src,
+        omega0=omega0,
+        m0=m0,
+        attitude0=attitude0,
+        torque=torque,
+        method=method,
+        workers=workers,
+        caller="solve_to_file",
+        **options,
+    )
+    method = run.method_name
+    problem, model = run.problem, run.model
+    n = run.n
     bshape = problem.batch_shape
     nchunks = -(-n // chunk)
 
     fingerprint = {
         "version": _STATE_VERSION,
         "method": method,
-        "options": json.loads(json.dumps(meth.config, default=float, sort_keys=True)),
+        "options": json.loads(json.dumps(run.options, default=float, sort_keys=True)),
         "inertia": np.asarray(problem.body.inertia).tolist(),
         "positions": None if problem.body.positions is None else problem.body.positions.tolist(),
         "q0": problem.q0.tolist(),
@@ -734,36 +474,16 @@ def solve_to_file(
     if not model.is_free:  # (free runs keep the fingerprint of earlier versions: their partial runs resume)
         fingerprint["torque"] = torque_fingerprint(model)
 
-    if overwrite:
-        check_replaceable(path)  # before any work, not after
-    if path.exists() and not overwrite:
-        if resume and _finished_run(path) == fingerprint:
-            return path  # the same run finished before: nothing to do
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it")
-    work = work_dir(path)
-    store = work / "store.zarr"
-    done: set[int] = set()
-    if work.exists():
-        try:
-            with open(work / "state.json", encoding="utf-8") as fh:
-                old = json.load(fh)
-        except (OSError, ValueError):
-            old = None  # interrupted while the store was being created: nothing was computed
-        if old is None or overwrite:
-            shutil.rmtree(work)
-        elif not resume:
-            raise EulerPoissonError(
-                f"an interrupted run to {path} left its finished chunks in {work}; pass resume=True "
-                "to continue it or overwrite=True to discard it"
-            )
-        elif old != fingerprint:
-            raise InvalidInputError(
-                f"resume=True: the partial run in {work} was started with different arguments "
-                "(body, initial state, times, method, options, chunk or variables); "
-                "pass overwrite=True to discard it"
-            )
-        else:
-            done = done_chunks(work)
+    partial = PartialRun(
+        path,
+        fingerprint,
+        resume=resume,
+        overwrite=overwrite,
+        finished=lambda p: _finished_run(p) == fingerprint,
+    )
+    if not partial.open():
+        return path  # the same run finished before: nothing to do
+    store, done = partial.store, partial.done
 
     # metadata template: a one-sample trajectory at the initial state
     template = Trajectory(
@@ -772,12 +492,11 @@ def solve_to_file(
         omega=problem.omega0[..., None, :],
         body=problem.body,
         method=method,
-        options=dict(meth.config),
+        options=run.options,
         torque=list(model.torques),
     ).to_xarray()
 
-    if not work.exists():
-        (work / "done").mkdir(parents=True)
+    def make_store(store: Path) -> None:
         with quiet_zarr():
             g = zarr.open_group(str(store), mode="w")
             attrs = dict(template.attrs)
@@ -808,7 +527,8 @@ def solve_to_file(
                 if "time" not in dims:
                     arr[...] = v.values
             zarr.consolidate_metadata(str(store))  # the partial store reads like the final one
-        write_json_atomic(work / "state.json", fingerprint)  # last: marks the store as complete and resumable
+
+    partial.create(make_store)
 
     with quiet_zarr():
         g = zarr.open_group(str(store), mode="r+")
@@ -819,58 +539,29 @@ def solve_to_file(
     def tslice(a, b):
         return (slice(None), slice(a, b)) if body_dim else (slice(a, b),)
 
-    # carried state for stepping methods / quaternion sign continuity
-    prev_q = None  # (*batch, 4) last quaternion of the previous chunk
-    prev_w = None
-    prev_t = None
-    direction = [0]  # sign of the time steps, fixed by the first chunk (stepping methods)
-
+    # resume: the storage chunks done form a prefix; the engine restarts at the segment that holds the first
+    # sample not done, from the stored state just before it (what it continued from the first time)
+    finished = 0
+    while finished < nchunks and finished in done:
+        finished += 1
+    first_todo = min(n, finished * chunk)
+    state = None
+    seg0 = run.segment_index(first_todo) if first_todo < n else len(run.bounds)
+    if seg0 < len(run.bounds) and run.bounds[seg0][0] > 0:
+        s = run.bounds[seg0][0]
+        with quiet_zarr():
+            q_prev = np.asarray(g["quaternion"][tslice(s - 1, s)]).reshape(bshape + (4,))
+            w_prev = np.asarray(g["omega"][tslice(s - 1, s)]).reshape(bshape + (3,))
+            state = (float(read_times(src, s - 1, s)[0]), q_prev, w_prev)
     n_done = sum(min(chunk, n - k * chunk) for k in done)
+    pending: dict[int, dict] = {}  # counters of storage chunks not complete yet
     try:
-        from ..util.jit import whole_run
-
-        # one choice of compiled kernels or NumPy for the whole run, not per chunk
-        with ProgressDisplay(progress, n, f"solving {method} to {path.name}") as bar, whole_run(n_times=n):
+        with ProgressDisplay(progress, n, f"solving {method} to {path.name}") as bar:
             bar.update(n_done)
-            for k in range(nchunks):
-                a, b = k * chunk, min(n, (k + 1) * chunk)
-                if k in done:
-                    prev_q = None
-                    continue
-                if prev_q is None and a > 0:  # resumed after finished chunks: the state they end in
-                    with quiet_zarr():
-                        prev_q = np.asarray(g["quaternion"][tslice(a - 1, a)]).reshape(bshape + (4,))
-                        prev_w = np.asarray(g["omega"][tslice(a - 1, a)]).reshape(bshape + (3,))
-                        prev_t = float(tarr[a - 1])
-                tc = _read_times(src, a, b)
-                if not closed_form:
-                    _check_monotonic(tc, prev_t, a, direction)
-                start = _time.perf_counter()
-                if closed_form or prev_q is None:
-                    tr = solve(
-                        model,
-                        tc,
-                        omega0=problem.omega0,
-                        attitude0=problem.q0,
-                        method=method,
-                        workers=workers,
-                        **options,
-                    )
-                else:
-                    assert prev_t is not None and prev_w is not None  # set with prev_q
-                    tr = solve_from(model, tc, prev_t, prev_q, prev_w, method=method, workers=workers, **options)
-                q = tr.quaternion
-                if prev_q is not None:
-                    # keep the quaternion sign continuous across the chunk boundary
-                    sgn = np.where(np.sum(prev_q * q[..., 0, :], -1) < 0, -1.0, 1.0)
-                    q = q * sgn[..., None, None]
-                    tr.quaternion = q
+            for seg in run.segments(seg0, state) if seg0 < len(run.bounds) else ():
+                tr = seg.trajectory
+                a, b = seg.start, seg.stop
                 data = _chunk_arrays(tr, variables)
-                wall = _time.perf_counter() - start
-                with quiet_zarr():
-                    for name, arr in arrays.items():
-                        arr[tslice(a, b)] = _flatten_batch(data[name], bshape)
-                    tarr[a:b] = tc
                 counters = {
                     key: val
                     for key, val in tr.stats.items()
@@ -878,12 +569,31 @@ def solve_to_file(
                     and not isinstance(val, bool)
                     and key not in ("wall_time", "threads")
                 }
-                mark_done(work, k, {"wall_time": wall, "stats": counters, "written": datetime.now(UTC).isoformat()})
-                prev_q = q[..., -1, :]
-                prev_w = tr.omega[..., -1, :]
-                prev_t = float(tc[-1])
-                n_done += b - a
-                bar.update(n_done)
+                # written storage chunk by storage chunk: each one complete is marked at once (after its data),
+                # so an interruption keeps every finished chunk; the segment's counters and time are shared out
+                # over its chunks by their samples (the totals of a resumed run are those of one run)
+                for k in range(a // chunk, -(-b // chunk)):
+                    c0, c1 = max(a, k * chunk), min(b, (k + 1) * chunk)
+                    with quiet_zarr():
+                        for name, arr in arrays.items():
+                            part = (
+                                data[name][..., c0 - a : c1 - a, :]
+                                if name in _VECTORS
+                                else data[name][..., c0 - a : c1 - a]
+                            )
+                            arr[tslice(c0, c1)] = _flatten_batch(part, bshape)
+                        tarr[c0:c1] = tr.t[c0 - a : c1 - a]
+                    share = (c1 - c0) / (b - a)
+                    acc = pending.setdefault(k, {"wall_time": 0.0, "stats": {}})
+                    acc["wall_time"] += seg.wall_time * share
+                    for key, val in counters.items():
+                        acc["stats"][key] = acc["stats"].get(key, 0.0) + float(val) * share  # type: ignore[arg-type]
+                    if c1 == min(n, (k + 1) * chunk) and k not in done:
+                        partial.mark(k, {**pending.pop(k), "written": datetime.now(UTC).isoformat()})
+                        n_done += min(chunk, n - k * chunk)
+                        bar.update(n_done)
+                    elif k in done:
+                        pending.pop(k, None)
     except KeyboardInterrupt as exc:
         exc.add_note(
             f"eulerpoisson: the finished chunks of {path} are kept in {store}; rerun with resume=True to continue"
@@ -893,15 +603,13 @@ def solve_to_file(
     # finalize: totals over all chunks (also those of earlier, interrupted sessions) in the attributes,
     # consolidated metadata, atomic rename
     totals: dict = {"chunks": nchunks, "wall_time": 0.0}
-    for k in range(nchunks):
-        try:
-            with open(work / "done" / f"{k:09d}", encoding="utf-8") as fh:
-                info = json.load(fh)
-        except (OSError, ValueError):
-            continue
+    for info in partial.infos().values():
         totals["wall_time"] += float(info.get("wall_time", 0.0))
         for key, val in info.get("stats", {}).items():
             totals[key] = totals.get(key, 0) + val
+    for key, val in totals.items():  # counts shared out over chunks add up to whole numbers again
+        if key != "wall_time" and isinstance(val, float) and abs(val - round(val)) < 1e-6 * max(1.0, abs(val)):
+            totals[key] = int(round(val))
     with quiet_zarr():
         g.attrs.update(
             {
@@ -913,20 +621,5 @@ def solve_to_file(
             }
         )
         zarr.consolidate_metadata(str(store))
-    replace_dir(store, path, overwrite)
-    shutil.rmtree(work, ignore_errors=True)
+    partial.publish()
     return path
-
-
-def _check_monotonic(tc: np.ndarray, prev_t, offset: int, direction: list) -> None:
-    full = tc if prev_t is None else np.concatenate([[prev_t], tc])
-    if full.size < 2:
-        return
-    d = np.diff(full)
-    if not direction[0]:
-        direction[0] = 1 if d[0] > 0 else -1
-    if not np.all(d * direction[0] > 0):
-        raise InvalidInputError(
-            f"t must be strictly monotonic for a stepping method (checked near index {offset}); "
-            "sort the times or use method='exact'"
-        )

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..errors import EulerPoissonError, InvalidInputError
+from ..errors import AuditError, InvalidInputError
 from . import symbolic as _sym
 from .audit_language import T3 as _T3
 from .audit_language import as_object as _as_object
@@ -43,10 +43,6 @@ __all__ = [
 N_POINTS = 4
 
 _DISPLAY_LIMIT = 2500
-
-
-class AuditError(EulerPoissonError, RuntimeError):
-    """Internal inconsistency of the audit (e.g. exact and random-point verdicts disagree)."""
 
 
 # ---------------------------------------------------------------------------

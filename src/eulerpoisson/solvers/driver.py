@@ -13,17 +13,13 @@ the exponential of the Hamiltonian vector field).
 
 from __future__ import annotations
 
-import time as _time
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InvalidInputError
 from ..trajectory import Trajectory
-from .parallel import check_workers, solve_batch
-from .problem import make_problem
-from .registry import MethodOptions, check_supported, get_method
+from .engine import collect, prepare_run
+from .registry import MethodOptions
 
 if TYPE_CHECKING:
     from ..attitude.core import AttitudeLike
@@ -43,7 +39,7 @@ def solve(
     attitude0: AttitudeLike | None = None,
     gibbs0: ArrayLike | None = None,
     torque: TorqueLike = None,
-    method: str | MethodOptions = "exact",
+    method: str | MethodOptions | None = None,
     workers: int | None = None,
     **options: Any,
 ) -> Trajectory:
@@ -75,12 +71,16 @@ def solve(
         ``BodyTorque``, ``SpaceTorque``; a callable ``torque(t, q, omega) ->
         tau_body`` vectorized over the batch; a list is their sum). None: the
         free body. For a heavy top the inertia is about the fixed point.
-    method : str or MethodOptions
-        A name from :func:`available_methods`: ``"exact"`` (closed form,
-        default: the free body and the Lagrange top) and the integrators; or
-        a method's typed options (``TaylorOptions(tol=1e-12)``,
+    method : str, MethodOptions or None
+        A name from :func:`available_methods`: ``"exact"`` (closed form:
+        the free body and the Lagrange top) and the integrators; or a
+        method's typed options (``TaylorOptions(tol=1e-12)``,
         ``SymplecticOptions(scheme="gauss6", dt=0.01)``, ...), which name
-        their method.
+        their method. None (default): the most accurate method that can run
+        the model, ``"exact"`` where the closed form exists, else
+        ``"taylor"`` (polynomial torques), else the first that can; the
+        trajectory's ``method`` records the choice. The command line makes
+        the same choice.
     workers : int or None
         Threads that solve a batch of bodies: chunks of the batch are solved
         in parallel by the compiled kernels (:mod:`~eulerpoisson.solvers.parallel`).
@@ -101,7 +101,13 @@ def solve(
         ``steps`` summed over the chunks of a threaded solve, maxima such
         as ``steps_max`` taken over them), ``wall_time`` (seconds from the
         start of the solution to the finished trajectory) and ``threads``
-        (the threads that solved the batch).
+        (the threads that solved the batch). A stepping method's long run
+        (more than :data:`~eulerpoisson.solvers.engine.SEGMENT` monotonic
+        output times, or a great many turns of the fastest body) is solved
+        in segments, each continued from the last state of the previous one,
+        exactly as a file of the same run is written
+        (:mod:`~eulerpoisson.solvers.engine`); ``stats["segments"]`` then
+        counts them.
 
     Raises
     ------
@@ -130,73 +136,18 @@ def solve(
     >>> tr.omega.shape
     (2, 3)
     """
-    check_workers(workers)
-    if isinstance(method, MethodOptions):
-        cls = get_method(method.method)
-        _check_keywords(cls, options)
-        m = cls(method, **options)
-        method = method.method
-    else:
-        cls = get_method(method)
-        _check_keywords(cls, options)
-        m = cls(**options)
-    problem = make_problem(body, t, omega0=omega0, m0=m0, attitude0=attitude0, gibbs0=gibbs0, torque=torque)
-    check_supported(method, problem.model)
-    if problem.extended and m.config.get("precision", "float64") == "float64":
-        import warnings
-
-        warnings.warn(
-            f"the initial state is given in long double; method {method!r} computes in float64 and rounds it "
-            f"(method='taylor' with precision='longdouble' keeps it)",
-            stacklevel=2,
-        )
-    if not cls.negative_times and np.any(problem.t < 0):
-        raise InvalidInputError(f"method {method!r} cannot run backwards in time; got negative times in t")
-    start = _time.perf_counter()
-    res = solve_batch(m, problem, workers)
-    tr = Trajectory(
-        t=problem.t,
-        quaternion=res.q,
-        omega=res.omega,
-        body=problem.body,
-        torque=problem.model.torques,
+    run = prepare_run(
+        body,
+        list(t) if isinstance(t, tuple) else t,  # a tuple is a list of times here (not solve_to_file's grid)
+        omega0=omega0,
+        m0=m0,
+        attitude0=attitude0,
+        gibbs0=gibbs0,
+        torque=torque,
         method=method,
-        options=dict(m.config),
-        stats={"wall_time": 0.0, **res.stats},
-        _prepared=res.prepared,
+        workers=workers,
+        in_memory=True,
+        stacklevel=3,
+        **options,
     )
-    # the solution and the trajectory's own work on it (normalization, sign continuity), which a threaded
-    # solve does in its threads
-    tr.stats["wall_time"] = _time.perf_counter() - start
-    return tr
-
-
-#: the keyword arguments of :func:`solve` itself
-_SOLVE_ARGUMENTS = ("omega0", "m0", "attitude0", "gibbs0", "torque", "method", "workers")
-
-
-def _check_keywords(cls, options) -> None:
-    """An unknown keyword is an error of ``solve`` (with the closest name), an option of another method is named so."""
-    import difflib
-
-    from .registry import available_methods
-
-    own = set(cls.options)
-    every = {name: set(get_method(name).options) for name in available_methods()}
-    for key in options:
-        if key in own:
-            continue
-        owners = sorted(name for name, opts in every.items() if key in opts)
-        if owners:
-            have = ", ".join(sorted(own)) or "none"
-            raise TypeError(
-                f"method {cls.name!r} has no option {key!r} (an option of {', '.join(owners)}); its options: {have}"
-            )
-        known = list(_SOLVE_ARGUMENTS) + sorted(own)
-        close = difflib.get_close_matches(key, known + sorted(set().union(*every.values())), n=1)
-        hint = f" (did you mean {close[0]!r}?)" if close else ""
-        raise TypeError(
-            f"solve() got an unexpected keyword argument {key!r}{hint}; arguments: "
-            f"{', '.join(_SOLVE_ARGUMENTS)}, and the options of method {cls.name!r}: "
-            f"{', '.join(sorted(own)) or 'none'}"
-        )
+    return collect(run)

@@ -145,24 +145,30 @@ def available_cores() -> int:
 
 
 def check_workers(workers: object, name: str = "workers") -> int | None:
-    """Validate a number of threads: an integer >= 1, or None (the default).
+    """Validate a number of threads: an integer >= 1, -1 for every core (as scipy spells it), or None (the default).
 
     Raises
     ------
     TypeError
         Not an integer (a bool, a float such as 2.0 or 2.5, a string).
     InvalidInputError
-        An integer below 1.
+        An integer below 1 other than -1.
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers.parallel import check_workers, resolve_workers, available_cores
+    >>> check_workers(2), check_workers(None), resolve_workers(-1) == available_cores()
+    (2, None, True)
     """
     if workers is None:
         return None
     if isinstance(workers, (bool, np.bool_)) or not isinstance(workers, numbers.Integral):
         raise TypeError(
-            f"{name} must be a whole number of threads >= 1, or None for every core; "
+            f"{name} must be a whole number of threads >= 1, -1 or None for every core; "
             f"got {type(workers).__name__} {workers!r}"
         )
-    if workers < 1:
-        raise InvalidInputError(f"{name} must be >= 1 (1: one thread), or None for every core; got {workers!r}")
+    if workers < 1 and workers != -1:
+        raise InvalidInputError(f"{name} must be >= 1 (1: one thread), or -1 or None for every core; got {workers!r}")
     return int(workers)
 
 
@@ -176,19 +182,19 @@ def resolve_workers(workers: object = None) -> int:
     """
     n = check_workers(workers)
     if n is not None:
-        return n
+        return available_cores() if n == -1 else n
     env = os.environ.get(ENV_WORKERS, "").strip()
     if env:
         try:
             value = int(env)
         except ValueError:
             value = None
-        if value is None or value < 1:
+        if value is None or (value < 1 and value != -1):
             raise InvalidInputError(
                 f"the environment variable {ENV_WORKERS} must be a whole number of threads "
-                f">= 1 (or unset: every core); got {env!r}"
+                f">= 1 (-1 or unset: every core); got {env!r}"
             )
-        return value
+        return available_cores() if value == -1 else value
     return available_cores()
 
 

@@ -20,6 +20,7 @@ from ..model.equations import Model
 from .problem import Problem
 
 __all__ = [
+    "hybridmethod",
     "MethodOptions",
     "Method",
     "MethodResult",
@@ -32,6 +33,24 @@ __all__ = [
 ]
 
 _REGISTRY: dict[str, type[Method]] = {}
+
+
+class hybridmethod:  # noqa: N801 - a decorator, named like classmethod
+    """A method bound to the instance when called on one, to the class otherwise.
+
+    :meth:`Method.supports` is one: ``Symplectic.supports(model)`` says whether
+    some configuration of the method runs the model, and
+    ``Symplectic(scheme="gauss4").supports(model)`` whether this one does.
+    """
+
+    def __init__(self, func):
+        self.func = func
+        self.__doc__ = func.__doc__
+
+    def __get__(self, obj, owner=None):
+        import functools
+
+        return functools.partial(self.func, owner if obj is None else obj)
 
 
 @dataclass
@@ -253,11 +272,16 @@ class Method:
         """
         return float("inf")
 
-    @classmethod
+    @hybridmethod
     def supports(cls, model: Model) -> str | None:
         """Why this method cannot run ``model`` (a sentence), or None when it can.
 
-        The default: the free body only. Methods that handle torques override it.
+        Asked of the class: whether some configuration of the method runs the
+        model; asked of a configured instance (as :func:`~eulerpoisson.solve`
+        does): whether this one does, with its options (e.g. a symplectic
+        scheme for the free body only). The default: the free body only.
+        Methods that handle torques override it (as a ``hybridmethod``
+        when the answer depends on the options).
         """
         if model.is_free:
             return None
@@ -354,8 +378,10 @@ def methods_supporting(model: Model) -> list[str]:
     return sorted(name for name, cls in _REGISTRY.items() if cls.supports(model) is None)
 
 
-def check_supported(name: str, model: Model) -> None:
+def check_supported(name: str | Method, model: Model) -> None:
     """Raise :class:`~eulerpoisson.errors.UnsupportedModelError` when method ``name`` cannot run ``model``.
+
+    ``name`` may be a configured method (an instance): then its options count (:meth:`Method.supports`).
 
     Raises
     ------
@@ -374,9 +400,11 @@ def check_supported(name: str, model: Model) -> None:
     method 'exact' cannot run this model: the closed form covers the free body and the Lagrange top ...;
     methods that can: rk, rk4, symplectic, taylor
     """
-    reason = get_method(name).supports(model)
+    method = name if isinstance(name, Method) else get_method(name)
+    reason = method.supports(model)
     if reason is None:
         return
+    name = method.name
     able = methods_supporting(model)
     hint = f"methods that can: {', '.join(able)}" if able else "no registered method can"
     raise UnsupportedModelError(f"method {name!r} cannot run this model: {reason}; {hint}")

@@ -157,6 +157,10 @@ def chart_bounds_numpy(q, r: float, jump_limit: float) -> list[tuple[int, int]]:
 def _chart_bounds_compiled():
     from numba import njit
 
+    from ..util.jit import activate
+
+    activate()  # the jitable helpers (qmul_components) are registered with numba before the kernel is typed
+
     @njit(cache=True)
     def bounds(q, r, jump_limit):  # pragma: no cover - compiled
         T = q.shape[0]

@@ -1,6 +1,6 @@
 r"""Lane kernel of the closed-form free rigid body (private): ``LANES`` evaluations in lockstep.
 
-:mod:`eulerpoisson.solvers.exact.kernels` evaluates one (body, time) after the
+The scalar kernel (:mod:`eulerpoisson.solvers.exact.scalar`) evaluates one (body, time) after the
 other; every evaluation is a few long chains of dependent operations (the
 double-double AGM of ``K``, the duplication of Carlson's ``R_F`` and ``R_J``,
 the Landen chain), so one core runs them at the speed of their latencies.
@@ -10,8 +10,8 @@ which LLVM turns into AVX2/AVX-512 code (the technique of the taylor lane
 kernel, see :mod:`eulerpoisson.solvers.taylor.kernels`):
 
 * ``LANES`` times of one body (the body set up in lane 0 and copied), or
-  ``LANES`` bodies set up together (:func:`_setup_lanes`: sorting, scaling and
-  regime; :func:`_params_lanes`: the AGM, the Landen chain and the ``R_F`` of
+  ``LANES`` bodies set up together (:mod:`~eulerpoisson.solvers.exact.lanes_setup`:
+  sorting, scaling and regime, then the AGM, the Landen chain and the ``R_F`` of
   the initial phase) and evaluated at each time together (the Monte-Carlo
   case: many bodies, one time each), whichever makes fewer blocks;
 * the evaluation (:func:`_eval_lanes`): the Jacobi functions (reduction and
@@ -22,8 +22,8 @@ kernel, see :mod:`eulerpoisson.solvers.taylor.kernels`):
 Each lane performs exactly the operations of the scalar kernel, by calling
 its helper functions (compiled inline); a lane that has converged (or takes
 the other branch) keeps its values while the others go on, so the results
-are those of :func:`~eulerpoisson.solvers.exact.kernels.body_setup` and
-:func:`~eulerpoisson.solvers.exact.kernels.body_eval` bit for bit, in every
+are those of :func:`~eulerpoisson.solvers.exact.scalar.body_setup` and
+:func:`~eulerpoisson.solvers.exact.scalar.body_eval` bit for bit, in every
 regime, the separatrix included (``tests/test_exact_lanes.py``).  The library
 calls (``sin``, ``sinh``, ``atan2``, ``hypot``, ...), the rescaling where
 ``2**k`` is not a normal number, the closed-form ``R_C`` terms of ``R_J``
@@ -42,15 +42,15 @@ run-time overlap check, and LLVM gives up beyond a few); whole vectors of
 ``R_J`` jobs (a scalar remainder loop runs the long Horner chain of the
 ``R_C`` series one job at a time).
 
-The per-body constants of lane ``l`` live at ``CL[k * LANES + l]`` (``k`` an
-index ``_C_*`` of :mod:`~eulerpoisson.solvers.exact.kernels`), so that the
+The per-body constants of lane ``l`` live at ``CL[k * LANES + l]`` (``k`` a
+field ``C_*`` of :mod:`~eulerpoisson.solvers.exact.state`), so that the
 vector loops read them contiguously; the scalar helpers see a lane's
 constants through the strided view ``CL[l::LANES]``.
 
 Note for development: numba's on-disk cache of a function is keyed on the
-source file that defines it only, and the compiled code of this module
-contains the helpers of ``kernels.py`` (and of ``numerics/elliptic.py``,
-``numerics/doubledouble.py``); after editing those alone, delete the
+source file that defines it only, and the compiled code of this module and of
+:mod:`~eulerpoisson.solvers.exact.lanes_setup` contains the helpers of ``scalar.py`` and
+``scalar_elliptic.py`` (and of ``numerics/elliptic.py``, ``numerics/doubledouble.py``); after editing those alone, delete the
 ``__pycache__/*.nbi``/``*.nbc`` files of this package (or touch this file).
 The first call in a fresh environment compiles the lane kernel in about 18 s
 (the scalar kernel alone took 7).
@@ -61,15 +61,109 @@ from __future__ import annotations
 import math
 
 from ...util.jit import USE_NUMBA, stack_buffer
-from . import kernels as _K
+from .lanes_setup import setup_lanes
+from .scalar import (
+    equilibrium_eval,
+    jsep,
+    jtot_args,
+    jtot_from,
+    near_xadd,
+    pick3,
+    qmin,
+    qmul,
+    theta_v,
+)
+from .scalar_elliptic import (
+    MAX_DUPLICATION,
+    RC_SERIES_MAX,
+    RDJ_QFAC,
+    SINCOS_POLY_MAX,
+    cos_poly,
+    dd_add,
+    dn_from_sc,
+    fast_sqrt,
+    imag_level,
+    quadrant,
+    rc1,
+    rc1_series,
+    real_level,
+    reduce,
+    rj_finish,
+    rj_init,
+    sech_real,
+    sin_poly,
+    two_prod,
+)
+from .state import (
+    C_A2,
+    C_AA,
+    C_AC,
+    C_CADD,
+    C_CASEB,
+    C_COEF,
+    C_EM,
+    C_ESCALE,
+    C_G0,
+    C_HAVE_JC,
+    C_HAVE_JCD,
+    C_HAVE_JFAR0,
+    C_HAVE_T0,
+    C_JC,
+    C_JCD,
+    C_JFAR0,
+    C_KFULL,
+    C_KH,
+    C_KL,
+    C_KP,
+    C_LAM,
+    C_M,
+    C_M0S,
+    C_M0S1,
+    C_M0S2,
+    C_M1,
+    C_MSCALE,
+    C_NADD,
+    C_NLEV,
+    C_NU,
+    C_NUD,
+    C_OMNU,
+    C_OMNUD,
+    C_PCL,
+    C_PCORR,
+    C_PERM0,
+    C_PERM1,
+    C_PH,
+    C_Q0W,
+    C_Q0X,
+    C_Q0Y,
+    C_Q0Z,
+    C_RATE,
+    C_SA,
+    C_SC,
+    C_SEP,
+    C_SGN1,
+    C_SN0,
+    C_SQM,
+    C_T0H,
+    C_T0L,
+    C_TAU0_C,
+    C_TAU0_D,
+    C_TAU0_N,
+    C_TAU0_R,
+    C_TAU0_S,
+    C_TAU0V,
+    C_THETA0,
+    C_TSCALE,
+    LANES,
+    MAX_LANDEN,
+    N_CONST,
+    N_TAU0V,
+)
 
 __all__ = ["LANES", "motion_lanes"]
 
-#: evaluations in lockstep
-LANES = 16
-_L = LANES
-_NC = _K.N_CONST
-_CL_SIZE = _NC * _L
+_L = LANES  # evaluations in lockstep (state.LANES)
+_CL_SIZE = N_CONST * _L
 #: R_J jobs of one evaluation of the lanes: at most 3 per lane and round
 _NJOB = 3 * _L
 #: Jacobi arguments of one evaluation: tau, tau0 (first evaluation), delta (near branch)
@@ -82,91 +176,20 @@ _L7 = 7 * _L
 _NJAC8 = 8 * _NJAC
 _ATT_IN = 17 * _L
 _JAC_LC = 9 * _L
-_JAC_LV = 2 * _K.MAX_LANDEN * _L
+_JAC_LV = 2 * MAX_LANDEN * _L
 _JAC_IN = 3 * _NJAC
 _JAC_W = 10 * _NJAC
-_PRE_SIZE = 34 * _L
 
-_C_SEP = _K.C_SEP
-_C_REGIME = _K.C_REGIME
-_C_EM = _K.C_EM
-_C_ESCALE = _K.C_ESCALE
-_C_M0S = _K.C_M0S
-_SEPARATRIX = _K.SEPARATRIX
-_REGIME_A = _K.REGIME_A
-_REGIME_B = _K.REGIME_B
-_C_CASEB = _K.C_CASEB
-_C_M = _K.C_M
-_C_M1 = _K.C_M1
-_C_KP = _K.C_KP
-_C_KH = _K.C_KH
-_C_KL = _K.C_KL
-_C_PH = _K.C_PH
-_C_PCORR = _K.C_PCORR
-_C_LAM = _K.C_LAM
-_C_T0H = _K.C_T0H
-_C_T0L = _K.C_T0L
-_C_AC = _K.C_AC
-_C_A2 = _K.C_A2
-_C_AA = _K.C_AA
-_C_SA = _K.C_SA
-_C_SC = _K.C_SC
-_C_RATE = _K.C_RATE
-_C_COEF = _K.C_COEF
-_C_NU = _K.C_NU
-_C_OMNU = _K.C_OMNU
-_C_JC = _K.C_JC
-_C_NADD = _K.C_NADD
-_C_CADD = _K.C_CADD
-_C_NUD = _K.C_NUD
-_C_OMNUD = _K.C_OMNUD
-_C_JCD = _K.C_JCD
-_C_G0 = _K.C_G0
-_C_TSCALE = _K.C_TSCALE
-_C_SN0 = _K.C_SN0
-_C_JFAR0 = _K.C_JFAR0
-_C_THETA0 = _K.C_THETA0
-_C_KFULL = _K.C_KFULL
-_C_Q0W = _K.C_Q0W
-_C_Q0X = _K.C_Q0X
-_C_Q0Y = _K.C_Q0Y
-_C_Q0Z = _K.C_Q0Z
-_C_PERM0 = _K.C_PERM0
-_C_SGN0 = _K.C_SGN0
-_C_NLEV = _K.C_NLEV
-_C_MSCALE = _K.C_MSCALE
-_C_TAU0V = _K.C_TAU0V
-_C_HAVE_JC = _K.C_HAVE_JC
-_C_HAVE_JCD = _K.C_HAVE_JCD
-_C_HAVE_JFAR0 = _K.C_HAVE_JFAR0
-_C_HAVE_T0 = _K.C_HAVE_T0
-_C_SQM = _K.C_SQM
-_C_PCL = _K.C_PCL
-_MAX_LANDEN = _K.MAX_LANDEN
-_MAX_AGM = _K.MAX_AGM
-_MAX_DUPLICATION = _K.MAX_DUPLICATION
-_LANDEN_THRESHOLD = _K.LANDEN_THRESHOLD
-_RF_QFAC = _K.RF_QFAC
-_RDJ_QFAC = _K.RDJ_QFAC
-_RC_SERIES_MAX = _K.RC_SERIES_MAX
-_SINCOS_POLY_MAX = _K.SINCOS_POLY_MAX
-_TWO200 = _K.TWO200
-_TWOM100 = _K.TWOM100
-_TWOM104 = _K.TWOM104
-_PI_HI = _K.PI_HI
-_PI_LO = _K.PI_LO
-_PIO2_HI = _K.PIO2_HI
-_PIO2_LO = _K.PIO2_LO
 _TINY_DELTA = 2.0**-960
 #: rows of CL copied by _jacobi_lanes
-_JAC_ROWS = (_C_SEP, _C_KH, _C_KL, _C_PH, _C_PCORR, _C_M, _C_M1, _C_KP, _C_NLEV)
+_JAC_ROWS = (C_SEP, C_KH, C_KL, C_PH, C_PCORR, C_M, C_M1, C_KP, C_NLEV)
 
 
 # =============================================================================
 # Carlson's R_J for a list of jobs
 # =============================================================================
 def _rj_jobs(X, Y, Z, P, R, n):
-    """``R[j] = R_J(X[j], Y[j], Z[j], P[j])`` for ``j < n`` (``kernels.rj3``, one job per slot).
+    """``R[j] = R_J(X[j], Y[j], Z[j], P[j])`` for ``j < n`` (``scalar_elliptic.rj3``, one job per slot).
 
     The slots run the duplication in lockstep, each with its own stopping
     rule; the ``R_C`` term of a step is the series (vector code) unless
@@ -214,7 +237,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
         y[j] = y0
         z[j] = z0
         p[j] = p0
-        # kernels.rj_init without the rescaling of a tiny delta (below)
+        # scalar_elliptic.rj_init without the rescaling of a tiny delta (below)
         a0 = (x0 + y0 + z0 + 2.0 * p0) / 5.0
         A0[j] = a0
         A[j] = a0
@@ -222,20 +245,20 @@ def _rj_jobs(X, Y, Z, P, R, n):
         acc[j] = 0.0
         dl[j] = (p0 - x0) * (p0 - y0) * (p0 - z0)
         sc[j] = 1.0
-        q[j] = _RDJ_QFAC * max(max(abs(a0 - x0), abs(a0 - y0)), max(abs(a0 - z0), abs(a0 - p0)))
+        q[j] = RDJ_QFAC * max(max(abs(a0 - x0), abs(a0 - y0)), max(abs(a0 - z0), abs(a0 - p0)))
     for j in range(n):
         if abs(dl[j]) < _TINY_DELTA:
-            a0, delta, s_, q_ = _K.rj_init(X0[j], Y0[j], Z0[j], p[j])
+            a0, delta, s_, q_ = rj_init(X0[j], Y0[j], Z0[j], p[j])
             dl[j] = delta
             sc[j] = s_
-    for _ in range(_MAX_DUPLICATION):
+    for _ in range(MAX_DUPLICATION):
         for j in range(n):
             f = F[j]
             RUN[j] = 1.0 if f * q[j] >= abs(A[j]) else 0.0
-            sx = _K.fast_sqrt(x[j])
-            sy = _K.fast_sqrt(y[j])
-            sz = _K.fast_sqrt(z[j])
-            sp = _K.fast_sqrt(p[j])
+            sx = fast_sqrt(x[j])
+            sy = fast_sqrt(y[j])
+            sz = fast_sqrt(z[j])
+            sp = fast_sqrt(p[j])
             lam = sx * sy + sy * sz + sz * sx
             d = (sp + sx) * (sp + sy) * (sp + sz)
             dd = d * sc[j]
@@ -244,20 +267,20 @@ def _rj_jobs(X, Y, Z, P, R, n):
             D[j] = d
             SP[j] = sp
             LM[j] = lam
-            RC[j] = _K.rc1_series(e)
+            RC[j] = rc1_series(e)
         # integer counts (vector code): running slots, and those whose R_C term needs the closed form
         nrun = 0
         nbig = 0
         for j in range(n):
             r = RUN[j] != 0.0
             nrun += 1 if r else 0
-            nbig += 1 if (r and not (abs(E[j]) <= _RC_SERIES_MAX)) else 0
+            nbig += 1 if (r and not (abs(E[j]) <= RC_SERIES_MAX)) else 0
         if nrun == 0:
             break
         if nbig > 0:
             for j in range(n):
-                if RUN[j] != 0.0 and not (abs(E[j]) <= _RC_SERIES_MAX):
-                    RC[j] = _K.rc1(E[j], SP[j], p[j], LM[j], D[j])
+                if RUN[j] != 0.0 and not (abs(E[j]) <= RC_SERIES_MAX):
+                    RC[j] = rc1(E[j], SP[j], p[j], LM[j], D[j])
         for j in range(n):
             r = RUN[j] != 0.0
             lam = LM[j]
@@ -270,7 +293,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
             z[j] = 0.25 * (z[j] + lam) if r else z[j]
             p[j] = 0.25 * (p[j] + lam) if r else p[j]
     for j in range(n):
-        E[j] = _K.rj_finish(A0[j], X0[j], Y0[j], Z0[j], A[j], F[j], acc[j])
+        E[j] = rj_finish(A0[j], X0[j], Y0[j], Z0[j], A[j], F[j], acc[j])
     for j in range(n):
         R[j] = E[j]
 
@@ -279,7 +302,7 @@ def _rj_jobs(X, Y, Z, P, R, n):
 # Jacobi elliptic functions, one argument per lane and group
 # =============================================================================
 def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
-    """Jacobi functions of the double-double arguments ``UH + UL`` (``kernels.sncndn3``).
+    """Jacobi functions of the double-double arguments ``UH + UL`` (``scalar_elliptic.sncndn3``).
 
     Slot ``j = g * LANES + l`` (group ``g < ng``, lane ``l < nl``) holds an
     argument of lane ``l``, whose constants are in ``CL``;
@@ -302,13 +325,13 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
     for l in range(nl):
         for k in range(9):
             LC[k * _L + l] = CL[_JAC_ROWS[k] * _L + l]
-        nlv = int(CL[_C_NLEV * _L + l])
+        nlv = int(CL[C_NLEV * _L + l])
         if nlv > maxlev:
             maxlev = nlv
     for i in range(maxlev):
         for l in range(nl):
-            LV[i * _L + l] = CL[(_C_SQM + i) * _L + l]
-            LV[(_MAX_LANDEN + i) * _L + l] = CL[(_C_PCL + i) * _L + l]
+            LV[i * _L + l] = CL[(C_SQM + i) * _L + l]
+            LV[(MAX_LANDEN + i) * _L + l] = CL[(C_PCL + i) * _L + l]
     nj = ng * _L
     for j in range(nj):
         IN[j] = UH[j]
@@ -319,7 +342,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         for l in range(nl):
             j = o + l
             sep = LC[l] != 0.0
-            n, r, neg, v, vn, dv = _K.reduce(
+            n, r, neg, v, vn, dv = reduce(
                 IN[j], IN[_NJAC + j], sep, LC[_L + l], LC[2 * _L + l], LC[3 * _L + l], LC[4 * _L + l]
             )
             W[j] = n
@@ -337,12 +360,12 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         o = g * _L
         for l in range(nl):
             j = o + l
-            # the real path's starting values by the polynomials (kernels._real_start), vector code
+            # the real path's starting values by the polynomials (scalar_elliptic._real_start), vector code
             # for every slot; the other paths overwrite them below
             vn = W[3 * _NJAC + j]
-            W[6 * _NJAC + j] = _K.sin_poly(vn)
-            W[7 * _NJAC + j] = _K.cos_poly(vn)
-            W[8 * _NJAC + j] = _K.sin_poly(0.5 * vn)
+            W[6 * _NJAC + j] = sin_poly(vn)
+            W[7 * _NJAC + j] = cos_poly(vn)
+            W[8 * _NJAC + j] = sin_poly(0.5 * vn)
     for g in range(ng):
         o = g * _L
         for l in range(nl):
@@ -355,16 +378,16 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                 W[7 * _NJAC + j] = math.cosh(vn)
                 any_imag = True
             elif im == 0.0:
-                if not (vn <= _SINCOS_POLY_MAX):
+                if not (vn <= SINCOS_POLY_MAX):
                     W[6 * _NJAC + j] = math.sin(vn)
                     W[7 * _NJAC + j] = math.cos(vn)
                     W[8 * _NJAC + j] = math.sin(0.5 * vn)
                 any_real = True
             elif im == 2.0:
-                # the separatrix (kernels._finish): tanh, sech of |r|
+                # the separatrix (scalar_elliptic._finish): tanh, sech of |r|
                 v = W[9 * _NJAC + j]
                 W[6 * _NJAC + j] = math.tanh(v)
-                W[7 * _NJAC + j] = _K.sech_real(v)
+                W[7 * _NJAC + j] = sech_real(v)
                 W[8 * _NJAC + j] = 0.0
             else:
                 W[6 * _NJAC + j] = 0.0
@@ -374,7 +397,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
         o = g * _L
         for l in range(nl):
             j = o + l
-            # kernels._imag_start / kernels._real_start: first-order correction for the low part
+            # scalar_elliptic._imag_start / scalar_elliptic._real_start: first-order correction for the low part
             dv = W[4 * _NJAC + j]
             im = W[5 * _NJAC + j]
             s0 = W[6 * _NJAC + j]
@@ -395,7 +418,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                     ok = (W[5 * _NJAC + j] == 1.0) & (fi < LC[8 * _L + l]) & (sq > 0.0)
                     s0 = W[6 * _NJAC + j]
                     c0 = W[7 * _NJAC + j]
-                    s1, c1 = _K.imag_level(s0, c0, sq)
+                    s1, c1 = imag_level(s0, c0, sq)
                     W[6 * _NJAC + j] = s1 if ok else s0
                     W[7 * _NJAC + j] = c1 if ok else c0
         if any_real:
@@ -408,7 +431,7 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
                     s0 = W[6 * _NJAC + j]
                     c0 = W[7 * _NJAC + j]
                     y0 = W[8 * _NJAC + j]
-                    s1, c1, y1 = _K.real_level(s0, c0, y0, sq, LV[(_MAX_LANDEN + i) * _L + l])
+                    s1, c1, y1 = real_level(s0, c0, y0, sq, LV[(MAX_LANDEN + i) * _L + l])
                     W[6 * _NJAC + j] = s1 if ok else s0
                     W[7 * _NJAC + j] = c1 if ok else c0
                     W[8 * _NJAC + j] = y1 if ok else y0
@@ -423,11 +446,9 @@ def _jacobi_lanes(CL, UH, UL, ON, ng, nl, O):
             Y0 = W[8 * _NJAC + j]
             sv = S0 / C0 if im else S0
             cv = 1.0 / C0 if im else (C0 if sp else (1.0 - Y0 if Y0 < 0.5 else C0))
-            dn_ = _K.dn_from_sc(sv, cv, LC[5 * _L + l], LC[6 * _L + l])
+            dn_ = dn_from_sc(sv, cv, LC[5 * _L + l], LC[6 * _L + l])
             dv = cv if sp else dn_
-            a, b, e, f, h, kk, u, w = _K.quadrant(
-                W[j], W[_NJAC + j], W[2 * _NJAC + j] != 0.0, sv, cv, dv, LC[7 * _L + l]
-            )
+            a, b, e, f, h, kk, u, w = quadrant(W[j], W[_NJAC + j], W[2 * _NJAC + j] != 0.0, sv, cv, dv, LC[7 * _L + l])
             OL[j] = a
             OL[_NJAC + j] = b
             OL[2 * _NJAC + j] = e
@@ -451,7 +472,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
     """``OUT[k * LANES + l]`` = ``(M_0, M_1, M_2, q_w, q_x, q_y, q_z)[k]`` of lane ``l < nl`` at time ``TT[l]``.
 
     Only the lanes ``ON`` (generic: not on the separatrix, ``t != 0``, normal
-    scale factors) are evaluated; the result is that of ``kernels.body_eval``
+    scale factors) are evaluated; the result is that of ``scalar.body_eval``
     bit for bit, including the constants computed on first use (stored in the
     lane's column of ``CL``).
     """
@@ -483,22 +504,22 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
     ALPHA = stack_buffer(_L)
     CA = stack_buffer(_L)
     SAL = stack_buffer(_L)
-    lam_r = CL[_C_LAM * _L : (_C_LAM + 1) * _L]
-    tsc_r = CL[_C_TSCALE * _L : (_C_TSCALE + 1) * _L]
-    t0h_r = CL[_C_T0H * _L : (_C_T0H + 1) * _L]
-    t0l_r = CL[_C_T0L * _L : (_C_T0L + 1) * _L]
-    kfull_r = CL[_C_KFULL * _L : (_C_KFULL + 1) * _L]
+    lam_r = CL[C_LAM * _L : (C_LAM + 1) * _L]
+    tsc_r = CL[C_TSCALE * _L : (C_TSCALE + 1) * _L]
+    t0h_r = CL[C_T0H * _L : (C_T0H + 1) * _L]
+    t0l_r = CL[C_T0L * _L : (C_T0L + 1) * _L]
+    kfull_r = CL[C_KFULL * _L : (C_KFULL + 1) * _L]
     # --- arguments: tau = lambda t + tau0 (double-double), near/far, first evaluation
     for l in range(nl):
         TS[l] = TT[l] * tsc_r[l]
     for l in range(nl):
         if tsc_r[l] == 0.0:
-            # 2**escale is not a normal number (kernels._ldexp)
-            TS[l] = math.ldexp(TT[l], int(CL[_C_ESCALE * _L + l]))
+            # 2**escale is not a normal number (scalar._ldexp)
+            TS[l] = math.ldexp(TT[l], int(CL[C_ESCALE * _L + l]))
     for l in range(nl):
         ts = TS[l]
-        dh, dl = _K.two_prod(lam_r[l], ts)
-        th, tl = _K.dd_add(dh, dl, t0h_r[l], t0l_r[l])
+        dh, dl = two_prod(lam_r[l], ts)
+        th, tl = dd_add(dh, dl, t0h_r[l], t0l_r[l])
         DH[l] = dh
         DLo[l] = dl
         UH[l] = th
@@ -511,7 +532,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         GF[l] = -1.0
         GN[l] = -1.0
         if ON[l] != 0.0:
-            if CL[_C_HAVE_T0 * _L + l] == 0.0:
+            if CL[C_HAVE_T0 * _L + l] == 0.0:
                 any_first = True
             if NEAR[l] != 0.0:
                 any_near = True
@@ -519,7 +540,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
     if any_first:
         o = ng * _L
         for l in range(nl):
-            first = ON[l] != 0.0 and CL[_C_HAVE_T0 * _L + l] == 0.0
+            first = ON[l] != 0.0 and CL[C_HAVE_T0 * _L + l] == 0.0
             UH[o + l] = t0h_r[l]
             UL[o + l] = t0l_r[l]
             JON[o + l] = 1.0 if first else 0.0
@@ -539,32 +560,32 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
     for l in range(nl):
         if ON[l] == 0.0:
             continue
-        ac = CL[_C_AC * _L + l]
-        kp = CL[_C_KP * _L + l]
-        a2 = CL[_C_A2 * _L + l]
+        ac = CL[C_AC * _L + l]
+        kp = CL[C_KP * _L + l]
+        a2 = CL[C_A2 * _L + l]
         if GF[l] >= 0.0:
             j = int(GF[l])
-            CL[_C_SN0 * _L + l] = O[j]
-            CL[_C_THETA0 * _L + l] = _K.theta_v(ac, kp, a2, O[3 * _NJAC + j], O[5 * _NJAC + j], O[6 * _NJAC + j])
-            for k in range(5):
-                CL[(_C_TAU0V + k) * _L + l] = O[(3 + k) * _NJAC + j]
-            CL[_C_HAVE_T0 * _L + l] = 1.0
-        THETA[l] = _K.theta_v(ac, kp, a2, O[3 * _NJAC + l], O[5 * _NJAC + l], O[6 * _NJAC + l])
+            CL[C_SN0 * _L + l] = O[j]
+            CL[C_THETA0 * _L + l] = theta_v(ac, kp, a2, O[3 * _NJAC + j], O[5 * _NJAC + j], O[6 * _NJAC + j])
+            for k in range(N_TAU0V):
+                CL[(C_TAU0V + k) * _L + l] = O[(3 + k) * _NJAC + j]
+            CL[C_HAVE_T0 * _L + l] = 1.0
+        THETA[l] = theta_v(ac, kp, a2, O[3 * _NJAC + l], O[5 * _NJAC + l], O[6 * _NJAC + l])
     # --- round one of R_J: far lanes (tau, tau0 on the first far evaluation, J_c), J_c of near lanes.
-    # The arguments of kernels._far for every lane in vector code (AUX rows: odd, S, S2, C2, D2, p at
+    # The arguments of scalar._far for every lane in vector code (AUX rows: odd, S, S2, C2, D2, p at
     # tau, then at tau0), the list of jobs lane by lane, the integrals from the R_J in vector code.
     for l in range(nl):
-        caseB = CL[_C_CASEB * _L + l] != 0.0
-        nu = CL[_C_NU * _L + l]
-        omnu = CL[_C_OMNU * _L + l]
-        kp = CL[_C_KP * _L + l]
+        caseB = CL[C_CASEB * _L + l] != 0.0
+        nu = CL[C_NU * _L + l]
+        omnu = CL[C_OMNU * _L + l]
+        kp = CL[C_KP * _L + l]
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
-        odd, S, S2, C2, D2, p = _K.jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l], O[7 * _NJAC + l], kp)
-        n0 = CL[_C_TAU0V * _L + l]
+        odd, S, S2, C2, D2, p = jtot_args(nu, omnu, neff, O[5 * _NJAC + l], O[6 * _NJAC + l], O[7 * _NJAC + l], kp)
+        n0 = CL[C_TAU0_N * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        odd0, S0, S20, C20, D20, p0 = _K.jtot_args(
-            nu, omnu, neff0, CL[(_C_TAU0V + 2) * _L + l], CL[(_C_TAU0V + 3) * _L + l], CL[(_C_TAU0V + 4) * _L + l], kp
+        odd0, S0, S20, C20, D20, p0 = jtot_args(
+            nu, omnu, neff0, CL[C_TAU0_S * _L + l], CL[C_TAU0_C * _L + l], CL[C_TAU0_D * _L + l], kp
         )
         AUX[l] = 1.0 if odd else 0.0
         AUX[_L + l] = S
@@ -594,7 +615,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 JP[nj] = AUX[5 * _L + l]
                 IT[l] = 1.0 * nj
                 nj += 1
-            if CL[_C_HAVE_JFAR0 * _L + l] == 0.0 and AUX[8 * _L + l] > 0.0:
+            if CL[C_HAVE_JFAR0 * _L + l] == 0.0 and AUX[8 * _L + l] > 0.0:
                 JX[nj] = AUX[9 * _L + l]
                 JY[nj] = AUX[10 * _L + l]
                 JZ[nj] = 1.0
@@ -604,12 +625,12 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             need_jc = True
         else:
             nd = O[3 * _NJAC + int(GN[l])]
-            need_jc = CL[_C_CASEB * _L + l] != 0.0 or nd != 0.0
-        if need_jc and CL[_C_HAVE_JC * _L + l] == 0.0:
+            need_jc = CL[C_CASEB * _L + l] != 0.0 or nd != 0.0
+        if need_jc and CL[C_HAVE_JC * _L + l] == 0.0:
             JX[nj] = 0.0
-            JY[nj] = CL[_C_M1 * _L + l]
+            JY[nj] = CL[C_M1 * _L + l]
             JZ[nj] = 1.0
-            JP[nj] = CL[_C_OMNU * _L + l]
+            JP[nj] = CL[C_OMNU * _L + l]
             IC[l] = 1.0 * nj
             nj += 1
     if nj > 0:
@@ -618,31 +639,31 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
         RT[l] = JR[int(IT[l])] if IT[l] >= 0.0 else 0.0
         R0[l] = JR[int(I0[l])] if I0[l] >= 0.0 else 0.0
         if ON[l] != 0.0 and IC[l] >= 0.0:
-            CL[_C_JC * _L + l] = JR[int(IC[l])] / 3.0
-            CL[_C_HAVE_JC * _L + l] = 1.0
+            CL[C_JC * _L + l] = JR[int(IC[l])] / 3.0
+            CL[C_HAVE_JC * _L + l] = 1.0
     for l in range(nl):
-        # kernels._far after its R_J (J_far(tau0) stored below where it is new)
-        caseB = CL[_C_CASEB * _L + l] != 0.0
-        m1 = CL[_C_M1 * _L + l]
-        jc = CL[_C_JC * _L + l]
-        n0 = CL[_C_TAU0V * _L + l]
+        # scalar._far after its R_J (J_far(tau0) stored below where it is new)
+        caseB = CL[C_CASEB * _L + l] != 0.0
+        m1 = CL[C_M1 * _L + l]
+        jc = CL[C_JC * _L + l]
+        n0 = CL[C_TAU0_N * _L + l]
         neff0 = n0 - 1.0 if caseB else n0
-        j0 = _K.jtot_from(
-            AUX[6 * _L + l] != 0.0, neff0, CL[(_C_TAU0V + 1) * _L + l], jc, AUX[7 * _L + l], AUX[8 * _L + l], R0[l]
+        j0 = jtot_from(
+            AUX[6 * _L + l] != 0.0, neff0, CL[C_TAU0_R * _L + l], jc, AUX[7 * _L + l], AUX[8 * _L + l], R0[l]
         )
         n = O[3 * _NJAC + l]
         neff = n - 1.0 if caseB else n
-        jj = _K.jtot_from(AUX[l] != 0.0, neff, O[4 * _NJAC + l], jc, AUX[_L + l], AUX[2 * _L + l], RT[l])
+        jj = jtot_from(AUX[l] != 0.0, neff, O[4 * _NJAC + l], jc, AUX[_L + l], AUX[2 * _L + l], RT[l])
         R0[l] = m1 * j0 if caseB else j0
         RT[l] = m1 * jj if caseB else jj
     for l in range(nl):
         if ON[l] == 0.0 or NEAR[l] != 0.0:
             continue
-        if CL[_C_HAVE_JFAR0 * _L + l] == 0.0:
-            CL[_C_JFAR0 * _L + l] = R0[l]
-            CL[_C_HAVE_JFAR0 * _L + l] = 1.0
-        DJ[l] = RT[l] - CL[_C_JFAR0 * _L + l]
-    # --- near lanes: addition theorem (kernels._near), round two of R_J
+        if CL[C_HAVE_JFAR0 * _L + l] == 0.0:
+            CL[C_JFAR0 * _L + l] = R0[l]
+            CL[C_HAVE_JFAR0 * _L + l] = 1.0
+        DJ[l] = RT[l] - CL[C_JFAR0 * _L + l]
+    # --- near lanes: addition theorem (scalar._near), round two of R_J
     if any_near:
         nj = 0
         for l in range(nl):
@@ -651,43 +672,41 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             if ON[l] == 0.0 or NEAR[l] == 0.0:
                 continue
             j = int(GN[l])
-            N = CL[_C_NADD * _L + l]
-            XADD[l] = _K.near_xadd(
-                N, CL[_C_CADD * _L + l], O[l] * CL[_C_SN0 * _L + l], O[j], O[_NJAC + j], O[2 * _NJAC + j]
-            )
+            N = CL[C_NADD * _L + l]
+            XADD[l] = near_xadd(N, CL[C_CADD * _L + l], O[l] * CL[C_SN0 * _L + l], O[j], O[_NJAC + j], O[2 * _NJAC + j])
             dlt = DH[l] + DLo[l]
-            caseB = CL[_C_CASEB * _L + l] != 0.0
-            g0 = CL[_C_G0 * _L + l]
-            m1 = CL[_C_M1 * _L + l]
-            use_sh = caseB and (abs(dlt) * g0 > m1 * CL[_C_JC * _L + l])
+            caseB = CL[C_CASEB * _L + l] != 0.0
+            g0 = CL[C_G0 * _L + l]
+            m1 = CL[C_M1 * _L + l]
+            use_sh = caseB and (abs(dlt) * g0 > m1 * CL[C_JC * _L + l])
             USH[l] = 1.0 if use_sh else 0.0
             n = O[3 * _NJAC + j]
             if use_sh:
-                nu = CL[_C_NU * _L + l]
-                omnu = CL[_C_OMNU * _L + l]
+                nu = CL[C_NU * _L + l]
+                omnu = CL[C_OMNU * _L + l]
                 nx = n - 1.0
             else:
-                nu = CL[_C_NUD * _L + l]
-                omnu = CL[_C_OMNUD * _L + l]
+                nu = CL[C_NUD * _L + l]
+                omnu = CL[C_OMNUD * _L + l]
                 nx = n
-            odd, S, S2, C2, D2, p = _K.jtot_args(
-                nu, omnu, nx, O[5 * _NJAC + j], O[6 * _NJAC + j], O[7 * _NJAC + j], CL[_C_KP * _L + l]
+            odd, S, S2, C2, D2, p = jtot_args(
+                nu, omnu, nx, O[5 * _NJAC + j], O[6 * _NJAC + j], O[7 * _NJAC + j], CL[C_KP * _L + l]
             )
             AUX[l] = 1.0 if odd else 0.0
             AUX[_L + l] = S
             AUX[2 * _L + l] = S2
-            if S2 > 0.0 and CL[_C_SEP * _L + l] == 0.0:
+            if S2 > 0.0 and CL[C_SEP * _L + l] == 0.0:
                 JX[nj] = C2
                 JY[nj] = D2
                 JZ[nj] = 1.0
                 JP[nj] = p
                 IT[l] = 1.0 * nj
                 nj += 1
-            if caseB and not use_sh and n != 0.0 and CL[_C_HAVE_JCD * _L + l] == 0.0:
+            if caseB and not use_sh and n != 0.0 and CL[C_HAVE_JCD * _L + l] == 0.0:
                 JX[nj] = 0.0
                 JY[nj] = m1
                 JZ[nj] = 1.0
-                JP[nj] = CL[_C_OMNUD * _L + l]
+                JP[nj] = CL[C_OMNUD * _L + l]
                 IC[l] = 1.0 * nj
                 nj += 1
         if nj > 0:
@@ -696,43 +715,43 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             if ON[l] == 0.0 or NEAR[l] == 0.0:
                 continue
             if IC[l] >= 0.0:
-                CL[_C_JCD * _L + l] = JR[int(IC[l])] / 3.0
-                CL[_C_HAVE_JCD * _L + l] = 1.0
+                CL[C_JCD * _L + l] = JR[int(IC[l])] / 3.0
+                CL[C_HAVE_JCD * _L + l] = 1.0
             j = int(GN[l])
             n = O[3 * _NJAC + j]
-            caseB = CL[_C_CASEB * _L + l] != 0.0
+            caseB = CL[C_CASEB * _L + l] != 0.0
             use_sh = USH[l] != 0.0
-            m1 = CL[_C_M1 * _L + l]
+            m1 = CL[C_M1 * _L + l]
             if use_sh:
                 nx = n - 1.0
-                jc = 1.0 if nx == 0.0 else CL[_C_JC * _L + l]
+                jc = 1.0 if nx == 0.0 else CL[C_JC * _L + l]
             else:
                 nx = n
                 if n == 0.0:
                     jc = 1.0
                 elif caseB:
-                    jc = CL[_C_JCD * _L + l]
+                    jc = CL[C_JCD * _L + l]
                 else:
-                    jc = CL[_C_JC * _L + l]
+                    jc = CL[C_JC * _L + l]
             rj = JR[int(IT[l])] if IT[l] >= 0.0 else 0.0
-            jd = _K.jtot_from(AUX[l] != 0.0, nx, O[4 * _NJAC + j], jc, AUX[_L + l], AUX[2 * _L + l], rj)
+            jd = jtot_from(AUX[l] != 0.0, nx, O[4 * _NJAC + j], jc, AUX[_L + l], AUX[2 * _L + l], rj)
             dlt = DH[l] + DLo[l]
-            if CL[_C_SEP * _L + l] != 0.0:
-                jd = _K.jsep(CL[_C_NADD * _L + l], dlt)
-            g0 = CL[_C_G0 * _L + l]
+            if CL[C_SEP * _L + l] != 0.0:
+                jd = jsep(CL[C_NADD * _L + l], dlt)
+            g0 = CL[C_G0 * _L + l]
             if caseB:
                 if use_sh:
-                    gdel = m1 * CL[_C_JC * _L + l] + m1 * jd
+                    gdel = m1 * CL[C_JC * _L + l] + m1 * jd
                 else:
                     gdel = g0 * (dlt - g0 * jd)
                 DJ[l] = gdel - g0 * g0 * XADD[l]
             else:
                 DJ[l] = jd + XADD[l]
-    # --- attitude (kernels.body_eval)
-    caseb_r = CL[_C_CASEB * _L : (_C_CASEB + 1) * _L]
-    rate_r = CL[_C_RATE * _L : (_C_RATE + 1) * _L]
-    coef_r = CL[_C_COEF * _L : (_C_COEF + 1) * _L]
-    th0_r = CL[_C_THETA0 * _L : (_C_THETA0 + 1) * _L]
+    # --- attitude (scalar.body_eval)
+    caseb_r = CL[C_CASEB * _L : (C_CASEB + 1) * _L]
+    rate_r = CL[C_RATE * _L : (C_RATE + 1) * _L]
+    coef_r = CL[C_COEF * _L : (C_COEF + 1) * _L]
+    th0_r = CL[C_THETA0 * _L : (C_THETA0 + 1) * _L]
     for l in range(nl):
         caseB = caseb_r[l] != 0.0
         psi = rate_r[l] * TS[l] + coef_r[l] * DJ[l]
@@ -749,31 +768,31 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
 
 
 def _attitude_lanes(CL, O, ON, CA, SAL, OUT, nl):
-    """The attitude and the outputs of lanes ``l < nl`` (``kernels.body_eval``) from the Jacobi functions in ``O``
+    """The attitude and the outputs of lanes ``l < nl`` (``scalar.body_eval``) from the Jacobi functions in ``O``
     and ``cos, sin`` of half the angle.
 
     Layout for LLVM's loop vectorizer: the inputs are first copied into one local buffer, the vector loop
     reads and writes local buffers only (no run-time overlap checks against the argument arrays, which
     LLVM otherwise needs for each pair and gives up beyond a few), the results are copied out at the end.
     Lanes that are off hold benign values (sn = 0, cn = dn = 1 from :func:`_jacobi_lanes`, the constants of
-    a body: :func:`_setup_lanes` gives relative equilibria neutral ones), so that no division by zero
+    a body: :func:`~eulerpoisson.solvers.exact.lanes_setup.setup_lanes` gives relative equilibria neutral ones), so that no division by zero
     occurs, also in plain Python.
     """
     IN = stack_buffer(_ATT_IN)
     OO = stack_buffer(_L10)
     for l in range(nl):
-        IN[l] = CL[_C_CASEB * _L + l]
-        IN[_L + l] = CL[_C_SA * _L + l]
-        IN[2 * _L + l] = CL[_C_SC * _L + l]
-        IN[3 * _L + l] = CL[_C_AC * _L + l]
-        IN[4 * _L + l] = CL[_C_A2 * _L + l]
-        IN[5 * _L + l] = CL[_C_AA * _L + l]
-        IN[6 * _L + l] = CL[_C_Q0W * _L + l]
-        IN[7 * _L + l] = CL[_C_Q0X * _L + l]
-        IN[8 * _L + l] = CL[_C_Q0Y * _L + l]
-        IN[9 * _L + l] = CL[_C_Q0Z * _L + l]
-        IN[10 * _L + l] = CL[_C_MSCALE * _L + l]
-        IN[11 * _L + l] = CL[(_C_SGN0 + 1) * _L + l]
+        IN[l] = CL[C_CASEB * _L + l]
+        IN[_L + l] = CL[C_SA * _L + l]
+        IN[2 * _L + l] = CL[C_SC * _L + l]
+        IN[3 * _L + l] = CL[C_AC * _L + l]
+        IN[4 * _L + l] = CL[C_A2 * _L + l]
+        IN[5 * _L + l] = CL[C_AA * _L + l]
+        IN[6 * _L + l] = CL[C_Q0W * _L + l]
+        IN[7 * _L + l] = CL[C_Q0X * _L + l]
+        IN[8 * _L + l] = CL[C_Q0Y * _L + l]
+        IN[9 * _L + l] = CL[C_Q0Z * _L + l]
+        IN[10 * _L + l] = CL[C_MSCALE * _L + l]
+        IN[11 * _L + l] = CL[C_SGN1 * _L + l]
         IN[12 * _L + l] = O[l]
         IN[13 * _L + l] = O[_NJAC + l]
         IN[14 * _L + l] = O[2 * _NJAC + l]
@@ -794,10 +813,10 @@ def _attitude_lanes(CL, O, ON, CA, SAL, OUT, nl):
         sal = IN[16 * _L + l]
         ex = 0.0 if caseB else sa * sal
         ez = sa * sal if caseB else 0.0
-        tw, tx, ty, tz = _K.qmin(M1, M2, M3, caseB, sa)
-        uw, ux, uy, uz = _K.qmul(IN[15 * _L + l], ex, 0.0, ez, tw, tx, ty, tz)
-        qw, qx, qy, qz = _K.qmul(IN[6 * _L + l], -IN[7 * _L + l], -IN[8 * _L + l], -IN[9 * _L + l], uw, ux, uy, uz)
-        nq = _K.fast_sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        tw, tx, ty, tz = qmin(M1, M2, M3, caseB, sa)
+        uw, ux, uy, uz = qmul(IN[15 * _L + l], ex, 0.0, ez, tw, tx, ty, tz)
+        qw, qx, qy, qz = qmul(IN[6 * _L + l], -IN[7 * _L + l], -IN[8 * _L + l], -IN[9 * _L + l], uw, ux, uy, uz)
+        nq = fast_sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
         fM = IN[10 * _L + l]
         s1 = IN[11 * _L + l]
         # sorted frame, with the sign of the permutation on the middle axis (1.0 * x keeps the bits)
@@ -812,17 +831,17 @@ def _attitude_lanes(CL, O, ON, CA, SAL, OUT, nl):
         OO[5 * _L + l] = s1 * (qy / nq)
         OO[6 * _L + l] = 1.0 * (qz / nq)
     for l in range(nl):
-        if CL[_C_MSCALE * _L + l] == 0.0:
-            # 2**eM is not a normal number (kernels._ldexp)
-            eM = int(CL[_C_EM * _L + l])
-            s1 = CL[(_C_SGN0 + 1) * _L + l]
+        if CL[C_MSCALE * _L + l] == 0.0:
+            # 2**eM is not a normal number (scalar._ldexp)
+            eM = int(CL[C_EM * _L + l])
+            s1 = CL[C_SGN1 * _L + l]
             OO[l] = 1.0 * math.ldexp(OO[7 * _L + l], eM)
             OO[_L + l] = s1 * math.ldexp(OO[8 * _L + l], eM)
             OO[2 * _L + l] = 1.0 * math.ldexp(OO[9 * _L + l], eM)
     for l in range(nl):
         # back to the input frame: x[perm[k]] = sgn[k] x_sorted[k]; input axis a holds sorted axis k with perm[k] = a
-        p0 = CL[_C_PERM0 * _L + l]
-        p1 = CL[(_C_PERM0 + 1) * _L + l]
+        p0 = CL[C_PERM0 * _L + l]
+        p1 = CL[C_PERM1 * _L + l]
         a0 = 0 if p0 == 0.0 else (1 if p1 == 0.0 else 2)
         a1 = 0 if p0 == 1.0 else (1 if p1 == 1.0 else 2)
         a2 = 0 if p0 == 2.0 else (1 if p1 == 2.0 else 2)
@@ -836,371 +855,26 @@ def _attitude_lanes(CL, O, ON, CA, SAL, OUT, nl):
 
 
 def _initial(CL, l, OUT):
-    """The exact initial condition of lane ``l`` (``t == 0``, ``kernels.body_eval``) into ``OUT``."""
-    s1 = CL[(_C_SGN0 + 1) * _L + l]
-    Ms0 = 1.0 * CL[_C_M0S * _L + l]
-    Ms1 = s1 * CL[(_C_M0S + 1) * _L + l]
-    Ms2 = 1.0 * CL[(_C_M0S + 2) * _L + l]
+    """The exact initial condition of lane ``l`` (``t == 0``, ``scalar.body_eval``) into ``OUT``."""
+    s1 = CL[C_SGN1 * _L + l]
+    Ms0 = 1.0 * CL[C_M0S * _L + l]
+    Ms1 = s1 * CL[C_M0S1 * _L + l]
+    Ms2 = 1.0 * CL[C_M0S2 * _L + l]
     qs0 = 1.0 * 0.0
     qs1 = s1 * 0.0
     qs2 = 1.0 * 0.0
-    p0 = CL[_C_PERM0 * _L + l]
-    p1 = CL[(_C_PERM0 + 1) * _L + l]
+    p0 = CL[C_PERM0 * _L + l]
+    p1 = CL[C_PERM1 * _L + l]
     a0 = 0 if p0 == 0.0 else (1 if p1 == 0.0 else 2)
     a1 = 0 if p0 == 1.0 else (1 if p1 == 1.0 else 2)
     a2 = 0 if p0 == 2.0 else (1 if p1 == 2.0 else 2)
-    OUT[l] = _K.pick3(a0, Ms0, Ms1, Ms2)
-    OUT[_L + l] = _K.pick3(a1, Ms0, Ms1, Ms2)
-    OUT[2 * _L + l] = _K.pick3(a2, Ms0, Ms1, Ms2)
+    OUT[l] = pick3(a0, Ms0, Ms1, Ms2)
+    OUT[_L + l] = pick3(a1, Ms0, Ms1, Ms2)
+    OUT[2 * _L + l] = pick3(a2, Ms0, Ms1, Ms2)
     OUT[3 * _L + l] = 1.0
-    OUT[4 * _L + l] = _K.pick3(a0, qs0, qs1, qs2)
-    OUT[5 * _L + l] = _K.pick3(a1, qs0, qs1, qs2)
-    OUT[6 * _L + l] = _K.pick3(a2, qs0, qs1, qs2)
-
-
-# =============================================================================
-# per-body set-up of the lanes
-# =============================================================================
-def _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl):
-    """``kernels.params`` of lanes ``l < nl`` at once: AGM, Landen chain, ``R_F`` (into ``CL``; ``R_F`` into ``PRF``)."""
-    m_ = stack_buffer(_L)
-    m1_ = stack_buffer(_L)
-    rx_ = stack_buffer(_L)
-    ry_ = stack_buffer(_L)
-    do_ = stack_buffer(_L)
-    AH = stack_buffer(_L)
-    AL = stack_buffer(_L)
-    BH = stack_buffer(_L)
-    BL = stack_buffer(_L)
-    AGM = stack_buffer(_L)
-    PC = stack_buffer(_L)
-    PC1 = stack_buffer(_L)
-    THR = stack_buffer(_L)
-    LAN = stack_buffer(_L)
-    NLEV = stack_buffer(_L)
-    RA0 = stack_buffer(_L)
-    RQ = stack_buffer(_L)
-    RA = stack_buffer(_L)
-    RFAC = stack_buffer(_L)
-    X = stack_buffer(_L)
-    Y = stack_buffer(_L)
-    Z = stack_buffer(_L)
-    RFON = stack_buffer(_L)
-    KH = stack_buffer(_L)
-    KL = stack_buffer(_L)
-    PPH = stack_buffer(_L)
-    PPL = stack_buffer(_L)
-    for l in range(nl):
-        m_[l] = PM[l]
-        m1_[l] = PM1[l]
-        rx_[l] = PRX[l]
-        ry_[l] = PRY[l]
-        do_[l] = PDO[l]
-    for l in range(nl):
-        m = m_[l]
-        m1 = m1_[l]
-        kp = _K.fast_sqrt(m1)
-        sep = m1 == 0.0
-        bh, bl = _K.dd_sqrt_f(m1 * _TWO200, 0.0)
-        AH[l] = 1.0
-        AL[l] = 0.0
-        BH[l] = 0.0 if sep else bh * _TWOM100
-        BL[l] = 0.0 if sep else bl * _TWOM100
-        AGM[l] = 0.0 if sep else 1.0
-        big = m > 0.5
-        PC[l] = m1 if big else m
-        PC1[l] = m if big else m1
-        THR[l] = 0.25 * _LANDEN_THRESHOLD * kp if big else _LANDEN_THRESHOLD
-        LAN[l] = 1.0
-        NLEV[l] = 0.0
-        rx = rx_[l]
-        ry = ry_[l]
-        rz = 1.0
-        ra0 = (rx + ry + rz) / 3.0
-        RA0[l] = ra0
-        RQ[l] = _RF_QFAC * max(max(abs(ra0 - rx), abs(ra0 - ry)), abs(ra0 - rz))
-        RA[l] = ra0
-        RFAC[l] = 1.0
-        X[l] = rx
-        Y[l] = ry
-        Z[l] = rz
-        RFON[l] = do_[l]
-    for it in range(_MAX_DUPLICATION):
-        agm_it = it < _MAX_AGM
-        for l in range(nl):
-            # AGM for K in double-double (kernels.params)
-            ah = AH[l]
-            al = AL[l]
-            bh = BH[l]
-            bl = BL[l]
-            dh, _dl = _K.dd_add(ah, al, -bh, -bl)
-            go = agm_it & (AGM[l] != 0.0) & (abs(dh) > _TWOM104 * ah)
-            sh, sl = _K.dd_add(ah, al, bh, bl)
-            ph, pl = _K.dd_mul_f(ah, al, bh, bl)
-            nbh, nbl = _K.dd_sqrt_f(ph, pl)
-            AH[l] = 0.5 * sh if go else ah
-            AL[l] = 0.5 * sl if go else al
-            BH[l] = nbh if go else bh
-            BL[l] = nbl if go else bl
-            AGM[l] = 1.0 if go else 0.0
-            # R_F duplication
-            ra = RA[l]
-            rfac = RFAC[l]
-            ron = (RFON[l] != 0.0) & (rfac * RQ[l] >= abs(ra))
-            x = X[l]
-            y = Y[l]
-            z = Z[l]
-            sx = _K.fast_sqrt(x)
-            sy = _K.fast_sqrt(y)
-            sz = _K.fast_sqrt(z)
-            lam = sx * sy + sy * sz + sz * sx
-            RA[l] = 0.25 * (ra + lam) if ron else ra
-            RFAC[l] = 0.25 * rfac if ron else rfac
-            X[l] = 0.25 * (x + lam) if ron else x
-            Y[l] = 0.25 * (y + lam) if ron else y
-            Z[l] = 0.25 * (z + lam) if ron else z
-            RFON[l] = 1.0 if ron else 0.0
-        if it < _MAX_LANDEN:
-            sq_r = CL[(_C_SQM + it) * _L : (_C_SQM + it + 1) * _L]
-            pcl_r = CL[(_C_PCL + it) * _L : (_C_PCL + it + 1) * _L]
-            for l in range(nl):
-                # descending Landen chain (level it: nlev == it while the chain runs)
-                pc = PC[l]
-                pc1 = PC1[l]
-                lon = (LAN[l] != 0.0) & (pc > THR[l])
-                kq = _K.fast_sqrt(pc1)
-                den = (1.0 + kq) * (1.0 + kq)
-                sq = pc / den
-                pn1 = 4.0 * kq / den
-                sq_r[l] = sq if lon else sq_r[l]
-                pcl_r[l] = pn1 if lon else pcl_r[l]
-                NLEV[l] = NLEV[l] + 1.0 if lon else NLEV[l]
-                PC[l] = sq * sq if lon else pc
-                PC1[l] = pn1 if lon else pc1
-                LAN[l] = 1.0 if lon else 0.0
-        else:
-            for l in range(nl):
-                LAN[l] = 0.0
-        busy = 0
-        for l in range(nl):
-            busy += 1 if (AGM[l] != 0.0) | (LAN[l] != 0.0) | (RFON[l] != 0.0) else 0
-        if busy == 0:
-            break
-    maxlev = 0
-    for l in range(nl):
-        nlv = int(NLEV[l])
-        if nlv > maxlev:
-            maxlev = nlv
-    for l in range(nl):
-        sep = m1_[l] == 0.0
-        kh, kl = _K.dd_div_f(_PI_HI, _PI_LO, AH[l], AL[l])
-        KH[l] = _PIO2_HI if sep else 0.5 * kh
-        KL[l] = _PIO2_LO if sep else 0.5 * kl
-        PPH[l] = 1.0
-        PPL[l] = 0.0
-    for i in range(maxlev):
-        fi = 1.0 * i
-        sq_r = CL[(_C_SQM + i) * _L : (_C_SQM + i + 1) * _L]
-        for l in range(nl):
-            ok = fi < NLEV[l]
-            oh, ol = _K.two_sum(1.0, sq_r[l])
-            ph, pl = _K.dd_mul(PPH[l], PPL[l], oh, ol)
-            PPH[l] = ph if ok else PPH[l]
-            PPL[l] = pl if ok else PPL[l]
-    for l in range(nl):
-        CL[_C_KP * _L + l] = _K.fast_sqrt(m1_[l])
-        CL[_C_KH * _L + l] = KH[l]
-        CL[_C_KL * _L + l] = KL[l]
-        CL[_C_PH * _L + l] = PPH[l]
-        CL[_C_PCORR * _L + l] = PPL[l] / PPH[l]
-        CL[_C_NLEV * _L + l] = NLEV[l]
-        PRF[l] = _K.rf_poly(RA0[l], rx_[l], ry_[l], RA[l], RFAC[l]) if do_[l] != 0.0 else 0.0
-
-
-def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
-    """``kernels.body_setup`` of bodies ``b0 .. b0 + nl - 1`` into lanes ``0 .. nl - 1`` (``EQ[l]``: relative equilibrium).
-
-    ``kernels.setup_pre`` in vector code (sorting, scaling, regime and constants of all lanes at
-    once; ``hypot`` lane by lane), :func:`_params_lanes`, then ``kernels.setup_post`` lane by lane.
-    Relative equilibria and bodies whose scale factors are not normal numbers are set up by the
-    scalar code (the same values).  Lanes ``nl ..`` get a copy of lane 0.
-    """
-    PRE = stack_buffer(_PRE_SIZE)
-    PM = stack_buffer(_L)
-    PM1 = stack_buffer(_L)
-    PRX = stack_buffer(_L)
-    PRY = stack_buffer(_L)
-    PDO = stack_buffer(_L)
-    PC0 = stack_buffer(_L)
-    PS0 = stack_buffer(_L)
-    PMa = stack_buffer(_L)
-    PMb = stack_buffer(_L)
-    PMc = stack_buffer(_L)
-    PRF = stack_buffer(_L)
-    H = stack_buffer(_L)
-    for l in range(nl):
-        b = b0 + l
-        i0 = inertia[b, 0]
-        i1 = inertia[b, 1]
-        i2 = inertia[b, 2]
-        m0 = M0[b, 0]
-        m1_ = M0[b, 1]
-        m2 = M0[b, 2]
-        p0, p1, p2, s1 = _K.perm3(i0, i1, i2)
-        I1u = _K.pick3(p0, i0, i1, i2)
-        I2u = _K.pick3(p1, i0, i1, i2)
-        I3u = _K.pick3(p2, i0, i1, i2)
-        M1u = 1.0 * _K.pick3(p0, m0, m1_, m2)
-        M2u = s1 * _K.pick3(p1, m0, m1_, m2)
-        M3u = 1.0 * _K.pick3(p2, m0, m1_, m2)
-        mmax = max(max(abs(M1u), abs(M2u)), abs(M3u))
-        eMx, okM = _K.exponent_lane(mmax)
-        eI, okI = _K.exponent_lane(I3u)
-        eM = 0 if mmax == 0.0 else eMx
-        fM = _K.pow2(-eM)
-        fI = _K.pow2(-eI)
-        M1 = M1u * fM
-        M2 = M2u * fM
-        M3 = M3u * fM
-        eq, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0, x, y = _K.pre_regime(
-            M1, M2, M3, I1u * fI, I2u * fI, I3u * fI
-        )
-        scalar = eq | ((mmax != 0.0) & (not okM)) | (not okI) | (fM == 0.0) | (fI == 0.0)
-        PRE[l] = 1.0 if scalar else 0.0
-        PRE[_L + l] = p0
-        PRE[2 * _L + l] = p1
-        PRE[3 * _L + l] = p2
-        PRE[4 * _L + l] = s1
-        PRE[5 * _L + l] = M1u
-        PRE[6 * _L + l] = M2u
-        PRE[7 * _L + l] = M3u
-        PRE[8 * _L + l] = eM
-        PRE[9 * _L + l] = eM - eI
-        PRE[10 * _L + l] = _K.pow2(eM)
-        PRE[11 * _L + l] = _K.pow2(eM - eI)
-        PRE[12 * _L + l] = M1
-        PRE[13 * _L + l] = M2
-        PRE[14 * _L + l] = M3
-        PRE[15 * _L + l] = m
-        PRE[16 * _L + l] = m1
-        PRE[17 * _L + l] = 1.0 if sep else 0.0
-        PRE[18 * _L + l] = 1.0 if caseB else 0.0
-        PRE[19 * _L + l] = Ac
-        PRE[20 * _L + l] = A2
-        PRE[21 * _L + l] = Aa
-        PRE[22 * _L + l] = lam
-        PRE[23 * _L + l] = sa
-        PRE[24 * _L + l] = sc
-        PRE[25 * _L + l] = rate
-        PRE[26 * _L + l] = coef
-        PRE[27 * _L + l] = Nadd
-        PRE[28 * _L + l] = nu
-        PRE[29 * _L + l] = omnu
-        PRE[30 * _L + l] = Cadd
-        PRE[31 * _L + l] = g0
-        PRE[32 * _L + l] = x
-        PRE[33 * _L + l] = y
-    for l in range(nl):
-        # the library's hypot, lane by lane (lanes set up by the scalar code are skipped)
-        H[l] = 1.0 if PRE[l] != 0.0 else math.hypot(PRE[32 * _L + l], PRE[33 * _L + l])
-    for l in range(nl):
-        m = PRE[15 * _L + l]
-        m1 = PRE[16 * _L + l]
-        c0, s0, delta2 = _K.pre_amplitude(H[l], PRE[32 * _L + l], PRE[33 * _L + l], m, m1)
-        EQ[l] = 0.0
-        PM[l] = m
-        PM1[l] = m1
-        PRX[l] = c0 * c0
-        PRY[l] = delta2
-        PDO[l] = 0.0 if PRE[17 * _L + l] != 0.0 else 1.0
-        PC0[l] = c0
-        PS0[l] = s0
-        PMa[l] = PRE[12 * _L + l]
-        PMb[l] = PRE[13 * _L + l]
-        PMc[l] = PRE[14 * _L + l]
-    for l in range(nl):
-        # kernels.setup_pre's stores (kernels._pre_store), all lanes
-        sep = PRE[17 * _L + l] != 0.0
-        caseB = PRE[18 * _L + l] != 0.0
-        CL[_C_PERM0 * _L + l] = PRE[_L + l]
-        CL[(_C_PERM0 + 1) * _L + l] = PRE[2 * _L + l]
-        CL[(_C_PERM0 + 2) * _L + l] = PRE[3 * _L + l]
-        CL[_C_SGN0 * _L + l] = 1.0
-        CL[(_C_SGN0 + 1) * _L + l] = PRE[4 * _L + l]
-        CL[(_C_SGN0 + 2) * _L + l] = 1.0
-        CL[_C_M0S * _L + l] = PRE[5 * _L + l]
-        CL[(_C_M0S + 1) * _L + l] = PRE[6 * _L + l]
-        CL[(_C_M0S + 2) * _L + l] = PRE[7 * _L + l]
-        CL[_C_EM * _L + l] = PRE[8 * _L + l]
-        CL[_C_ESCALE * _L + l] = PRE[9 * _L + l]
-        CL[_C_MSCALE * _L + l] = PRE[10 * _L + l]
-        CL[_C_TSCALE * _L + l] = PRE[11 * _L + l]
-        CL[_C_REGIME * _L + l] = _SEPARATRIX if sep else (_REGIME_B if caseB else _REGIME_A)
-        CL[_C_CASEB * _L + l] = 1.0 if caseB else 0.0
-        CL[_C_SEP * _L + l] = 1.0 if sep else 0.0
-        CL[_C_M * _L + l] = PRE[15 * _L + l]
-        CL[_C_M1 * _L + l] = PRE[16 * _L + l]
-        CL[_C_NU * _L + l] = PRE[28 * _L + l]
-        CL[_C_OMNU * _L + l] = PRE[29 * _L + l]
-        CL[_C_HAVE_JC * _L + l] = 0.0
-        CL[_C_HAVE_JCD * _L + l] = 0.0
-        CL[_C_HAVE_JFAR0 * _L + l] = 0.0
-        CL[_C_HAVE_T0 * _L + l] = 0.0
-        CL[_C_LAM * _L + l] = PRE[22 * _L + l]
-        CL[_C_AC * _L + l] = PRE[19 * _L + l]
-        CL[_C_A2 * _L + l] = PRE[20 * _L + l]
-        CL[_C_AA * _L + l] = PRE[21 * _L + l]
-        CL[_C_SA * _L + l] = PRE[23 * _L + l]
-        CL[_C_SC * _L + l] = PRE[24 * _L + l]
-        CL[_C_RATE * _L + l] = PRE[25 * _L + l]
-        CL[_C_COEF * _L + l] = PRE[26 * _L + l]
-        Nadd = PRE[27 * _L + l]
-        CL[_C_NADD * _L + l] = Nadd
-        CL[_C_CADD * _L + l] = PRE[30 * _L + l]
-        CL[_C_G0 * _L + l] = PRE[31 * _L + l]
-        CL[_C_NUD * _L + l] = -Nadd if caseB else PRE[28 * _L + l]
-        CL[_C_OMNUD * _L + l] = 1.0 + Nadd if caseB else PRE[29 * _L + l]
-    for l in range(nl):
-        if PRE[l] != 0.0:
-            # relative equilibria, scale factors that are not normal numbers: the scalar code
-            b = b0 + l
-            eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = _K.setup_pre(
-                inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], CL[l::_L]
-            )
-            EQ[l] = 1.0 if eq else 0.0
-            PM[l] = m
-            PM1[l] = m1
-            PRX[l] = rx
-            PRY[l] = ry
-            PDO[l] = 1.0 if do_rf else 0.0
-            PC0[l] = c0
-            PS0[l] = s0
-            PMa[l] = M1
-            PMb[l] = M2
-            PMc[l] = M3
-    for l in range(nl, _L):
-        # lanes beyond nl compute along (vector loops over all lanes) with lane 0's inputs
-        EQ[l] = 0.0
-        PM[l] = PM[0]
-        PM1[l] = PM1[0]
-        PRX[l] = PRX[0]
-        PRY[l] = PRY[0]
-        PDO[l] = PDO[0]
-    _params_lanes(PM, PM1, PRX, PRY, PDO, CL, PRF, nl)
-    for l in range(nl):
-        if EQ[l] == 0.0:
-            _K.setup_post(CL[l::_L], PRF[l], PC0[l], PS0[l], PMa[l], PMb[l], PMc[l])
-        else:
-            # a relative equilibrium is evaluated by the caller; its lane computes along with neutral values
-            for k in (_C_AC, _C_A2, _C_AA, _C_SA, _C_SC, _C_Q0W, _C_MSCALE, _C_TSCALE, _C_LAM, _C_KFULL, _C_M, _C_M1):
-                CL[k * _L + l] = 1.0
-            for k in (_C_Q0X, _C_Q0Y, _C_Q0Z, _C_CASEB, _C_SEP, _C_T0H, _C_T0L, _C_RATE, _C_COEF, _C_THETA0):
-                CL[k * _L + l] = 0.0
-    if nl < _L:
-        for k in range(_NC):
-            v = CL[k * _L]
-            for l in range(nl, _L):
-                CL[k * _L + l] = v
+    OUT[4 * _L + l] = pick3(a0, qs0, qs1, qs2)
+    OUT[5 * _L + l] = pick3(a1, qs0, qs1, qs2)
+    OUT[6 * _L + l] = pick3(a2, qs0, qs1, qs2)
 
 
 # =============================================================================
@@ -1209,7 +883,7 @@ def _setup_lanes(inertia, M0, b0, nl, CL, EQ):
 def motion_lanes(inertia, M0, t, Mout, qout):
     """Fill ``Mout`` (nb, T, 3) and ``qout`` (nb, T, 4) for bodies (nb, 3) and times (T,).
 
-    The results of ``kernels.motion_kernel_scalar`` bit for bit. Either each
+    The results of ``scalar.motion_kernel_scalar`` bit for bit. Either each
     body is set up once (in lane 0, copied to the others) and its times run
     in blocks of ``LANES``, or ``LANES`` bodies are set up at once and run
     together at each time,
@@ -1237,11 +911,11 @@ def motion_lanes(inertia, M0, t, Mout, qout):
             m0 = M0[b, 0]
             m1 = M0[b, 1]
             m2 = M0[b, 2]
-            _setup_lanes(inertia, M0, b, 1, CL, EQ)  # lane 0, copied to the other lanes
+            setup_lanes(inertia, M0, b, 1, CL, EQ)  # lane 0, copied to the other lanes
             if EQ[0] != 0.0:
                 EQ[0] = 0.0
                 for j in range(T):
-                    r0, r1, r2, r3, r4, r5, r6 = _K.equilibrium_eval(i0, i1, i2, m0, m1, m2, t[j])
+                    r0, r1, r2, r3, r4, r5, r6 = equilibrium_eval(i0, i1, i2, m0, m1, m2, t[j])
                     Mout[b, j, 0] = r0
                     Mout[b, j, 1] = r1
                     Mout[b, j, 2] = r2
@@ -1256,12 +930,12 @@ def motion_lanes(inertia, M0, t, Mout, qout):
     else:
         for b0 in range(0, nb, _L):
             nl = min(_L, nb - b0)
-            _setup_lanes(inertia, M0, b0, nl, CL, EQ)
+            setup_lanes(inertia, M0, b0, nl, CL, EQ)
             for j in range(T):
                 for l in range(nl):
                     if EQ[l] != 0.0:
                         b = b0 + l
-                        r0, r1, r2, r3, r4, r5, r6 = _K.equilibrium_eval(
+                        r0, r1, r2, r3, r4, r5, r6 = equilibrium_eval(
                             inertia[b, 0], inertia[b, 1], inertia[b, 2], M0[b, 0], M0[b, 1], M0[b, 2], t[j]
                         )
                         Mout[b, j, 0] = r0
@@ -1328,11 +1002,5 @@ if USE_NUMBA:  # pragma: no branch
     _attitude_lanes = _jit(_attitude_lanes)
     _eval_lanes = _jit(_eval_lanes)
     _initial = _jit(_initial)
-    _params_lanes = _jit(_params_lanes)
-    _setup_lanes = _jit(_setup_lanes)
     _run_block = _jit_inline(_run_block)
     motion_lanes = _jit(motion_lanes)
-
-# kernels.motion_kernel is this function (kernels imports this module last; whichever module is
-# imported first, both end up with the same compiled function)
-_K.motion_kernel = motion_lanes

@@ -108,7 +108,7 @@ from ...numerics.quaternion import qmul
 from ...util.jit import USE_NUMBA
 from .. import charts as ch
 from ..problem import Problem
-from ..registry import Method, MethodOptions, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, hybridmethod, register_method
 
 __all__ = ["Symplectic", "GaussTableau", "gauss_tableau", "gauss_step", "splitting_sequence", "splitting_advance"]
 
@@ -670,10 +670,23 @@ class Symplectic(Method):
         """Order of convergence of the configured scheme (2, 4 or 6; 4 for the default)."""
         return SCHEMES[self.config["scheme"] or "gauss4"]
 
-    @classmethod
+    @hybridmethod
     def supports(cls, model) -> str | None:
+        """Whether the method (its configured scheme, when asked of an instance) runs ``model``."""
         if model.is_free:
             return None
+        scheme = cls.config["scheme"] if isinstance(cls, Symplectic) else None
+        if scheme is not None and scheme not in TORQUE_SCHEMES:
+            return (
+                f"scheme {scheme!r} solves the free body only (the model has {model.describe()}); under torque "
+                "use scheme='exact_splitting' (order 2) or 'exact_splitting4' (order 4)"
+            )
+        if any(t.depends_on_omega for t in model.torques) or model.polynomial() is None:
+            return (
+                "its splitting kicks with torques that depend on the time and the attitude only (Gravity, "
+                f"GravityGradient, BodyTorque, SpaceTorque), and the model has {model.describe()}"
+            )
+        return None
         if any(t.depends_on_omega for t in model.torques) or model.polynomial() is None:
             return (
                 "its splitting kicks with torques that depend on the time and the attitude only (Gravity, "

@@ -240,6 +240,11 @@ class PartialRun:
         mark_done(self.work, k, info)
         self.done.add(k)
 
+    def forget(self, k: int) -> None:
+        """Chunk ``k`` is not finished after all (its data failed verification): its marker is removed."""
+        (self.work / "done" / f"{k:09d}").unlink(missing_ok=True)
+        self.done.discard(k)
+
     def infos(self) -> dict[int, dict]:
         """The markers' records by chunk (those unreadable are left out)."""
         out = {}

@@ -539,7 +539,37 @@ def solve_to_file(
     def tslice(a, b):
         return (slice(None), slice(a, b)) if body_dim else (slice(a, b),)
 
-    # resume: the storage chunks done form a prefix; the engine restarts at the segment that holds the first
+    def chunk_digest(k: int, parts: dict[str, np.ndarray] | None = None) -> str:
+        """sha256 of chunk ``k`` as written (``parts``) or as stored now (read back from the store)."""
+        c0, c1 = k * chunk, min(n, (k + 1) * chunk)
+        h = hashlib.sha256()
+        for name in (*variables, "time"):
+            if parts is not None:
+                a = parts[name]
+            else:
+                with quiet_zarr():
+                    a = np.asarray(
+                        (tarr if name == "time" else arrays[name])[
+                            (slice(c0, c1),) if name == "time" else tslice(c0, c1)
+                        ]
+                    )
+            h.update(np.ascontiguousarray(a).tobytes())
+        return h.hexdigest()
+
+    # resume: every finished chunk is verified before it is trusted (its checksum recorded when it was written,
+    # and its data decoded); a chunk that fails is computed again (a damaged store is never published)
+    infos = partial.infos() if done else {}
+    for k in sorted(done):
+        want = infos.get(k, {}).get("sha256")
+        try:
+            ok = want is None or chunk_digest(k) == want  # (markers of older versions have no checksum)
+            if want is None:
+                chunk_digest(k)  # at least readable
+        except Exception:  # noqa: BLE001 - undecodable or missing chunk data: computed again
+            ok = False
+        if not ok:
+            partial.forget(k)
+    # the storage chunks done form a prefix; the engine restarts at the segment that holds the first
     # sample not done, from the stored state just before it (what it continued from the first time)
     finished = 0
     while finished < nchunks and finished in done:
@@ -574,6 +604,7 @@ def solve_to_file(
                 # over its chunks by their samples (the totals of a resumed run are those of one run)
                 for k in range(a // chunk, -(-b // chunk)):
                     c0, c1 = max(a, k * chunk), min(b, (k + 1) * chunk)
+                    written = pending.setdefault(k, {"wall_time": 0.0, "stats": {}, "parts": {}})["parts"]
                     with quiet_zarr():
                         for name, arr in arrays.items():
                             part = (
@@ -581,15 +612,25 @@ def solve_to_file(
                                 if name in _VECTORS
                                 else data[name][..., c0 - a : c1 - a]
                             )
-                            arr[tslice(c0, c1)] = _flatten_batch(part, bshape)
+                            flat = _flatten_batch(part, bshape)
+                            arr[tslice(c0, c1)] = flat
+                            written.setdefault(name, []).append(flat)
                         tarr[c0:c1] = tr.t[c0 - a : c1 - a]
+                        written.setdefault("time", []).append(tr.t[c0 - a : c1 - a])
                     share = (c1 - c0) / (b - a)
-                    acc = pending.setdefault(k, {"wall_time": 0.0, "stats": {}})
+                    acc = pending[k]
                     acc["wall_time"] += seg.wall_time * share
                     for key, val in counters.items():
                         acc["stats"][key] = acc["stats"].get(key, 0.0) + float(val) * share  # type: ignore[arg-type]
                     if c1 == min(n, (k + 1) * chunk) and k not in done:
-                        partial.mark(k, {**pending.pop(k), "written": datetime.now(UTC).isoformat()})
+                        info = pending.pop(k)
+                        axis = 1 if body_dim else 0
+                        parts = {
+                            name: np.concatenate(v, axis=0 if name == "time" else axis)
+                            for name, v in info.pop("parts").items()
+                        }
+                        info["sha256"] = chunk_digest(k, parts)
+                        partial.mark(k, {**info, "written": datetime.now(UTC).isoformat()})
                         n_done += min(chunk, n - k * chunk)
                         bar.update(n_done)
                     elif k in done:

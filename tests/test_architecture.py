@@ -27,7 +27,6 @@ LAZY_ACCESSORS = {
     ("eulerpoisson.trajectory", "eulerpoisson.io.read"),  # Trajectory.open
     ("eulerpoisson.trajectory", "eulerpoisson.solvers.engine"),  # Trajectory.__call__ (the dense output)
     ("eulerpoisson.io.read", "eulerpoisson.viz.plots"),  # LazyTrajectory.plot
-    ("eulerpoisson.estimation.result", "eulerpoisson.estimation.plots"),  # FitResult.plot
 }
 
 LOWER = ("numerics", "attitude", "model", "trajectory")

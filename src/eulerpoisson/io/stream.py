@@ -88,13 +88,11 @@ Zarr storage specification version 3, https://zarr-specs.readthedocs.io.
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import json
 import numbers
 import os
 import sys
-import warnings
 from collections.abc import Callable, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
@@ -105,10 +103,9 @@ from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError, require
 from ..solvers.engine import TimeGrid, as_time_source, read_times
-from .resumable import (
-    PartialRun,
-    partial_store,
-)
+from ..version import package_version
+from .resumable import PartialRun, partial_store
+from .zarr import create_trajectory_store, quiet_zarr
 
 if TYPE_CHECKING:
     from ..attitude.core import AttitudeLike
@@ -215,16 +212,6 @@ def _finished_run(path: Path):
         return json.loads(raw) if isinstance(raw, str) else None
     except Exception:  # noqa: BLE001 - anything unreadable is "not a finished run of ours"
         return None
-
-
-@contextlib.contextmanager
-def quiet_zarr():
-    """Silence zarr's warnings about v3 extensions (fixed-width strings, consolidated metadata)."""
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message=".*Zarr format 3 specification.*")
-        warnings.filterwarnings("ignore", message=".*does not have a Zarr V3 specification.*")
-        warnings.filterwarnings("ignore", message=".*Consolidated metadata.*")
-        yield
 
 
 # ---------------------------------------------------------------------------
@@ -419,7 +406,6 @@ def solve_to_file(
     from ..util.validate import as_scalar
 
     zarr = require("zarr", "dask")
-    require("xarray", "io")
 
     path = Path(path)
     chunk = int(as_scalar(chunk, "chunk", positive=True, integer=True))
@@ -485,7 +471,7 @@ def solve_to_file(
         return path  # the same run finished before: nothing to do
     store, done = partial.store, partial.done
 
-    # metadata template: a one-sample trajectory at the initial state
+    # the layout of the run's file, from a one-sample trajectory at the initial state (its body, model, method)
     template = Trajectory(
         t=[0.0],
         quaternion=problem.q0[..., None, :],
@@ -494,39 +480,13 @@ def solve_to_file(
         method=method,
         options=run.options,
         torque=list(model.torques),
-    ).to_xarray()
+    )
+    version = package_version()
 
     def make_store(store: Path) -> None:
-        with quiet_zarr():
-            g = zarr.open_group(str(store), mode="w")
-            attrs = dict(template.attrs)
-            attrs.update({"T": n, "stream_chunk": chunk, "stats": "{}"})
-            g.attrs.update(attrs)
-            for name in list(template.coords) + list(template.data_vars):
-                v = template[name]
-                if "time" in v.dims and name != "time" and name not in variables:
-                    continue
-                dims = list(v.dims)
-                shape = list(v.shape)
-                chunks = list(v.shape)
-                if "time" in dims:
-                    i = dims.index("time")
-                    shape[i] = n
-                    chunks[i] = min(chunk, n)
-                kind = v.dtype.kind
-                fill = np.nan if kind == "f" else ("" if kind == "U" else 0)
-                arr = g.create_array(
-                    name,
-                    shape=tuple(shape),
-                    chunks=tuple(chunks),
-                    dtype=v.dtype,
-                    fill_value=fill,
-                    dimension_names=dims,
-                )
-                arr.attrs.update(dict(v.attrs))
-                if "time" not in dims:
-                    arr[...] = v.values
-            zarr.consolidate_metadata(str(store))  # the partial store reads like the final one
+        create_trajectory_store(
+            store, template, n=n, chunk=chunk, variables=variables, attrs={"T": n, "stream_chunk": chunk, "stats": "{}"}
+        )
 
     partial.create(make_store)
 
@@ -656,7 +616,7 @@ def solve_to_file(
             {
                 "stats": json.dumps(totals, default=float, sort_keys=True),
                 "history": f"{datetime.now(UTC).isoformat(timespec='seconds')} streamed by "
-                f"eulerpoisson {template.attrs['eulerpoisson_version']} in {nchunks} chunks of {chunk}",
+                f"eulerpoisson {version} in {nchunks} chunks of {chunk}",
                 # the arguments of the run: a later resume=True with the same ones finds it complete
                 "eulerpoisson_run": json.dumps(fingerprint, sort_keys=True, default=float),
             }

@@ -59,6 +59,13 @@ $(VENV)/.installed-peers: | $(VENV)/.installed-test
 bench: $(VENV)/.installed-test $(VENV)/.installed-peers
 	$(BIN)/python benchmarks/run.py
 
+# the release check (issue 22): python -m build (an sdist and a wheel, LICENSE in both), the wheel installed
+# into a fresh virtual environment, away from the source tree, running eulerpoisson --version, warmup, demo
+# and the README's tour (tests/test_release.py). Minutes, and the package index: not part of make test.
+.PHONY: release-check
+release-check: $(VENV)/.installed-test
+	EULERPOISSON_RELEASE_CHECK=1 $(BIN)/python -m pytest -n 0 -q -p no:cacheprovider tests/test_release.py
+
 # the documentation site into docs/_build/html: Sphinx, warnings and broken references are errors; runs the
 # gallery (examples/) and the paper's audit (SPHINXOPTS="-D plot_gallery=0 -D eulerpoisson_run_audit=0" skips both)
 SPHINXOPTS ?=

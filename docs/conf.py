@@ -22,6 +22,7 @@ release = eulerpoisson.__version__
 version = release
 
 extensions = [
+    "ep_cli",  # the command-line reference, generated from the parser (.. eulerpoisson-cli::)
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
@@ -34,6 +35,9 @@ extensions = [
 if importlib.util.find_spec("sphinx-mathjax-offline") is not None:
     extensions.append("sphinx-mathjax-offline")
 
+# smart quotes without "--" -> en dash: a flag written outside a literal (--quaternion-order) stays
+# a flag that can be copied and pasted
+smartquotes_action = "qe"
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 root_doc = "index"
 exclude_patterns = ["_build", "_ext", "_templates", "**/GALLERY_HEADER.rst"]

@@ -23,3 +23,9 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261121)
+
+
+@pytest.fixture(autouse=True)
+def _crash_reports_in_a_temporary_folder(tmp_path_factory, monkeypatch):
+    """The command line saves the traceback of an internal error under $XDG_CACHE_HOME: not the user's, in tests."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path_factory.getbasetemp() / "cache"))

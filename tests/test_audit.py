@@ -17,6 +17,8 @@ import subprocess
 
 import pytest
 
+from _limits import HANG_GUARD_S
+
 pytest.importorskip("sympy")
 
 from eulerpoisson.errors import InvalidInputError  # noqa: E402
@@ -265,7 +267,7 @@ def test_latex_document_structure_and_compiles(report, tmp_path):
         cwd=tmp_path,
         capture_output=True,
         text=True,
-        timeout=240,
+        timeout=HANG_GUARD_S,
     )
     assert proc.returncode == 0, proc.stdout[-3000:]
     assert (tmp_path / "audit.pdf").stat().st_size > 10000

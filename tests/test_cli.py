@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from eulerpoisson.cli import main
 
 
@@ -158,7 +159,7 @@ def test_console_script_entry_point(tmp_path):
         [exe, "simulate", "--inertia", "1,2,3", "--omega", "1,0,0", "--t-end", "nan"],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_GUARD_S,
     )
     assert res.returncode == 2
     assert len(res.stderr.strip().splitlines()) == 1

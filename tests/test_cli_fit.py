@@ -130,10 +130,14 @@ def test_bad_files_are_one_line_and_exit_2(capsys, tmp_path, good_rows, kind, ma
 def test_existing_outputs_need_overwrite(capsys, tmp_path, good_rows):
     obs = _write(tmp_path / "obs.csv", _csv(good_rows))
     out_json = tmp_path / "fit.json"
-    out_json.write_text("{}")
+    code, out, err = run(  # a first fit result (--overwrite replaces only a file of the kind fit writes)
+        capsys, "fit", obs, "--out", str(out_json), "--sigma-attitude", "0.01", "--sigma-omega", "1e-5"
+    )
+    assert code == 0, err
+    first = out_json.read_text()
     code, out, err = run(capsys, "fit", obs, "--out", str(out_json))
     assert code == 2 and "--overwrite" in err
-    assert out_json.read_text() == "{}"
+    assert out_json.read_text() == first
     code, out, err = run(
         capsys, "fit", obs, "--out", str(out_json), "--overwrite", "--sigma-attitude", "0.01", "--sigma-omega", "1e-5"
     )

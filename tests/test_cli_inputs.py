@@ -243,22 +243,53 @@ def test_config_that_is_a_directory_or_empty_name(capsys, tmp_path):
     [
         (
             MemoryError("Unable to allocate 745. GiB"),
-            r"^eulerpoisson: error: out of memory: Unable to allocate 745\. GiB$",
+            r"^eulerpoisson: error: out of memory: Unable to allocate 745\. GiB \(.*fewer samples or bodies.*\.zarr",
         ),
         (OverflowError(34, "Numerical result out of range"), r"^eulerpoisson: error: numerical overflow: "),
-        (ZeroDivisionError("float division by zero"), r"^eulerpoisson: error: float division by zero$"),
-        (KeyError("no variable named 'inertia'"), r"^eulerpoisson: error: no variable named 'inertia'$"),
-        (RuntimeError("something odd\nsecond line"), r"^eulerpoisson: error: RuntimeError: something odd$"),
-        (AssertionError(), r"^eulerpoisson: error: AssertionError: AssertionError$"),
-        (IndexError("index 3 is out of bounds"), r"^eulerpoisson: error: index 3 is out of bounds$"),
+        (InvalidInputError("omega0 is odd\nsecond line"), r"^eulerpoisson: error: omega0 is odd$"),
+        (FileNotFoundError(2, "No such file or directory", "x.nc"), r"^eulerpoisson: error: .*x\.nc"),
     ],
 )
-def test_any_exception_is_one_line(capsys, monkeypatch, exc, match):
+def test_bad_input_and_machine_limits_are_one_line_exit_2(capsys, monkeypatch, exc, match):
     def boom(*a, **k):
         raise exc
 
     monkeypatch.setattr(engine, "prepare_run", boom)  # the one engine every route runs
     one_error(capsys, BASE, match)
+    with pytest.raises(type(exc)):
+        main(BASE + ["--debug"])  # --debug shows the traceback
+
+
+@pytest.mark.parametrize(
+    "exc, match",
+    [
+        (ZeroDivisionError("float division by zero"), r"ZeroDivisionError: float division by zero"),
+        (KeyError("no variable named 'inertia'"), r"KeyError: no variable named 'inertia'"),
+        (RuntimeError("something odd\nsecond line"), r"RuntimeError: something odd"),
+        (AssertionError(), r"AssertionError: AssertionError"),
+        (IndexError("index 3 is out of bounds"), r"IndexError: index 3 is out of bounds"),
+        (ValueError("not enough values to unpack (expected 3, got 2)"), r"ValueError: not enough values to unpack"),
+    ],
+)
+def test_any_unexpected_exception_is_one_line_internal_error_exit_3(capsys, monkeypatch, tmp_path, exc, match):
+    # issue 22 (20): a bug must not look like the user's mistake: "internal error", the traceback saved, exit 3
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+
+    def boom(*a, **k):
+        raise exc
+
+    monkeypatch.setattr(engine, "prepare_run", boom)  # the one engine every route runs
+    code, out, err = run(capsys, *BASE)
+    lines = err.strip().splitlines()
+    assert code == 3 and out == "" and len(lines) == 1 and "Traceback" not in err, (code, err)
+    m = re.fullmatch(
+        r"eulerpoisson: internal error: (.*) \(a bug; the traceback was saved to (.*); please report it\)", lines[0]
+    )
+    assert m and re.match(match, m.group(1)), lines[0]
+    saved = m.group(2)
+    assert saved.startswith(str(tmp_path / "cache" / "eulerpoisson")), saved
+    text = open(saved, encoding="utf-8").read()
+    assert "Traceback (most recent call last)" in text and type(exc).__name__ in text and "simulate" in text
     with pytest.raises(type(exc)):
         main(BASE + ["--debug"])  # --debug shows the traceback
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from eulerpoisson.cli import main
 
 
@@ -142,7 +143,7 @@ def test_a_closed_pipe_is_not_an_error(tmp_path):
         f"{exe} simulate --inertia 1,2,3 --omega 1,0.1,0.5 --t-end 10 --samples 200000 --method exact --json "
         f"| head -c 10"
     )
-    res = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True, timeout=120)
+    res = subprocess.run(["bash", "-o", "pipefail", "-c", cmd], capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert "Broken pipe" not in res.stderr, res.stderr
     assert res.returncode == 0, res.stderr
 

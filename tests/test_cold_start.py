@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from _markers import needs_numba
 from eulerpoisson.cli import main
 from eulerpoisson.solvers import get_method, parallel
@@ -49,7 +50,7 @@ def default_threshold(monkeypatch):
 def _python(code: str, **env) -> dict:
     """Run ``code`` in a fresh interpreter; it prints one JSON line (the last line of stdout)."""
     res = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=300, env=_default_env(**env)
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=HANG_GUARD_S, env=_default_env(**env)
     )
     assert res.returncode == 0, res.stderr[-3000:]
     return json.loads(res.stdout.strip().splitlines()[-1])
@@ -227,7 +228,7 @@ def test_first_small_simulate_with_an_empty_numba_cache(tmp_path):
         env=env,
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_GUARD_S,
     )
     wall = time.perf_counter() - t0
     assert res.returncode == 0, res.stderr
@@ -281,7 +282,11 @@ def test_threshold_from_the_environment(monkeypatch):
 
 def test_warmup_without_numba():
     res = subprocess.run(
-        [EXE, "warmup"], capture_output=True, text=True, timeout=300, env=_default_env(EULERPOISSON_NO_NUMBA="1")
+        [EXE, "warmup"],
+        capture_output=True,
+        text=True,
+        timeout=HANG_GUARD_S,
+        env=_default_env(EULERPOISSON_NO_NUMBA="1"),
     )
     assert res.returncode == 0, res.stderr
     assert "nothing to compile" in res.stdout

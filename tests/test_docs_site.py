@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 import eulerpoisson
+from _limits import HANG_GUARD_S
 
 pytest.importorskip("sphinx", reason="the docs extra is not installed (pip install -e '.[docs]')")
 
@@ -43,7 +44,7 @@ def _build(tmp):
     options = "-b html -n -W --keep-going -q -D plot_gallery=0 -D eulerpoisson_run_audit=0".split()
     cmd = [sys.executable, "-m", "sphinx", *options, str(tmp / "docs"), str(out)]
     env = {**os.environ, "MPLBACKEND": "Agg", "PYTHONWARNINGS": "default"}
-    return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=600), out
+    return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=HANG_GUARD_S), out
 
 
 # one test, one build (about 40 s): split into several, pytest-xdist would build the site once per worker

@@ -35,6 +35,7 @@ import textwrap
 
 import numpy as np
 
+from _limits import HANG_GUARD_S
 from _markers import needs_numba
 from eulerpoisson.solvers.exact import kernels as K
 from eulerpoisson.solvers.exact.motion import (
@@ -306,7 +307,7 @@ def test_numpy_fallback_in_subprocess_matches(tmp_path):
         ],
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_GUARD_S,
         env=_numpy_libm_env(),
     )
     assert proc.returncode == 0, proc.stderr[-3000:]

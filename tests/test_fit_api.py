@@ -286,7 +286,8 @@ INPUT_ERRORS = [
         dict(attitude=Q11, initial={"inertia": MOMENTS, "omega0": W0, "attitude0": [0.0] * 4}),
         r"initial attitude0 contains a zero quaternion",
     ),
-    ("max_iter < 0", dict(attitude=Q11, max_iter=-1), r"max_iter must be a non-negative integer"),
+    ("max_iter < 0", dict(attitude=Q11, max_iter=-1), r"max_iter must be a positive integer"),
+    ("max_iter = 0", dict(attitude=Q11, max_iter=0), r"max_iter must be a positive integer"),
     ("batch of fixed inertias", dict(attitude=Q11, inertia=[MOMENTS, MOMENTS]), r"inertia must describe one body"),
 ]
 
@@ -325,7 +326,7 @@ def test_non_numeric_input_raises_type_error(kw, match):
 
 @pytest.mark.parametrize("max_iter", ["10", None, 2.5, True])
 def test_max_iter_must_be_an_integer(max_iter):
-    with pytest.raises(TypeError, match="max_iter must be a non-negative integer"):
+    with pytest.raises(TypeError, match="max_iter must be a positive integer"):
         ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=max_iter)
 
 
@@ -344,10 +345,11 @@ def test_sigma_may_be_nan_where_the_observation_is_missing():
     assert 4 not in np.searchsorted(T11, res.residuals["attitude_t"])
 
 
-def test_max_iter_zero_reports_not_converged():
-    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=0)
-    assert not res.converged
-    assert "NOT converged" in res.summary()
+def test_max_iter_one_reports_not_converged():
+    """max_iter = 0 is refused (issue 22 #12); one iteration from a start far off does not converge, and says so."""
+    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=1, accept_poor_fit=True)
+    if not res.converged:
+        assert "NOT converged" in res.summary()
 
 
 # ----------------------------------------------------------------------------
@@ -365,7 +367,7 @@ def test_attitude_object_and_scipy_rotation_are_converted_right():
         _assert_recovers(r, MOMENTS, W0, Q0)
         assert abs(r.chi2 - fits[0].chi2) < 1e-12
     # the scalar-last array itself, read as scalar-first, is another motion: not what was observed
-    wrong = ep.fit(t, attitude=scalar_last, attitude_sigma=1e-3)
+    wrong = ep.fit(t, attitude=scalar_last, attitude_sigma=1e-3, accept_poor_fit=True)
     assert _angle(wrong.attitude0.as_quaternion(), Q0) > 0.1
 
 
@@ -545,7 +547,7 @@ def test_fixed_inertia():
         assert np.abs(r.inertia - _trace1(MOMENTS)).max() < 1e-15
         _assert_recovers(r, MOMENTS, W0, Q0)
     # a wrong fixed inertia cannot explain the data
-    wrong = ep.fit(t, attitude=q, attitude_sigma=1e-3, inertia=[0.3, 0.3, 0.4])
+    wrong = ep.fit(t, attitude=q, attitude_sigma=1e-3, inertia=[0.3, 0.3, 0.4], accept_poor_fit=True)
     assert wrong.reduced_chi2 > 100
     # rates only, inertia fixed: the attitude is not seen, three unknowns
     r = ep.fit(t, omega=w, omega_sigma=1e-3, inertia=MOMENTS)
@@ -575,7 +577,7 @@ def test_full_tensor_principal_axes_fit():
     assert np.abs(np.abs(np.sum(V * Rb, axis=0)) - 1).max() < 1e-8  # the same axes, up to sign
     assert np.allclose(V @ np.diag(res.principal_moments) @ V.T, res.inertia, atol=1e-14)
     # the diagonal model cannot explain a rotated tensor
-    diag = ep.fit(t, attitude=q, attitude_sigma=1e-3)
+    diag = ep.fit(t, attitude=q, attitude_sigma=1e-3, accept_poor_fit=True)
     assert diag.reduced_chi2 > 1e3
 
 
@@ -685,6 +687,9 @@ def test_to_json(noisy, tmp_path):
         "n_observations",
         "local_optima",
         "rms_residuals",
+        "sigma_units",
+        "poor_fit",
+        "convention_hint",
     }
     assert d["epoch"] == res.epoch and d["chi2"] == res.chi2 and d["dof"] == res.dof
     assert np.array_equal(d["inertia"], res.inertia) and np.array_equal(d["omega0"], res.omega0)
@@ -1030,7 +1035,9 @@ def test_plots_of_rates_only_and_full_tensor_fits(plt, tmp_path):
     rates = ep.fit(t, omega=_space(q, w), omega_sigma=1e-3, omega_frame="space")
     paths = rates.save_plots(tmp_path)
     assert len(paths) == 3 and all(p.stat().st_size > 1000 for p in paths)
-    spin = ep.fit(t, omega=w, omega_sigma=1e-3, inertia=[0.3, 0.3, 0.4])  # symmetric: no finite polhode period
+    spin = ep.fit(
+        t, omega=w, omega_sigma=1e-3, inertia=[0.3, 0.3, 0.4], accept_poor_fit=True
+    )  # symmetric: no finite polhode period
     assert spin.plot_polhode() is not None
 
 

@@ -29,6 +29,7 @@ import pytest
 zarr = pytest.importorskip("zarr")
 
 import eulerpoisson as ep  # noqa: E402
+from _limits import HANG_GUARD_S  # noqa: E402
 from eulerpoisson.cli import main  # noqa: E402
 from eulerpoisson.io import read as R  # noqa: E402
 from eulerpoisson.io.stream import TimeGrid, partial_store, solve_to_file  # noqa: E402
@@ -354,7 +355,7 @@ def test_info_of_a_killed_simulate(capsys, tmp_path):
     proc = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     done = tmp_path / ".k.zarr.partial" / "done"
     try:
-        for _ in range(2400):
+        for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
             if (done.exists() and len(list(done.iterdir())) >= 2) or proc.poll() is not None:
                 break
             time.sleep(0.05)
@@ -364,7 +365,7 @@ def test_info_of_a_killed_simulate(capsys, tmp_path):
         assert "resume      not now" in out
     finally:
         proc.send_signal(signal.SIGKILL)
-        proc.wait(timeout=60)
+        proc.wait(timeout=HANG_GUARD_S)
     code, out, err = run(capsys, "info", store)
     assert code == 0, err
     m = re.match(

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from eulerpoisson.cli import main
 
 pytest.importorskip("zarr")
@@ -77,15 +78,15 @@ def test_a_second_writer_to_the_same_store_fails_and_the_first_finishes(tmp_path
     argv = [EXE, *SIM, "--t-end", "1000", "--samples", "3000000", "--out", str(store), "--quiet"]
     first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     lock = tmp_path / ".c.zarr.lock"
-    for _ in range(600):
+    for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
         if lock.exists() or first.poll() is not None:
             break
         time.sleep(0.05)
     assert lock.exists(), "the first writer did not take the lock"
-    second = subprocess.run(argv, capture_output=True, text=True, timeout=300)
+    second = subprocess.run(argv, capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert second.returncode == 2
     assert "is being written by another process" in second.stderr and len(second.stderr.strip().splitlines()) == 1
-    out, err = first.communicate(timeout=600)
+    out, err = first.communicate(timeout=HANG_GUARD_S)
     assert first.returncode == 0, err
     with xr.open_zarr(store) as ds:
         assert ds.sizes["time"] == 3_000_000
@@ -98,16 +99,16 @@ def test_an_interrupted_stream_resumes_where_it_stopped(tmp_path):
     argv = [EXE, *SIM, "--t-end", "2000", "--samples", "4000000", "--method", "taylor", "--out", str(store)]
     proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     done = tmp_path / ".r.zarr.partial" / "done"
-    for _ in range(1200):
+    for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
         if (done.exists() and len(list(done.iterdir())) >= 2) or proc.poll() is not None:
             break
         time.sleep(0.05)
     # 2 of about 40 chunks are done: the rest takes far longer than one poll interval
     assert proc.poll() is None, "the run ended before it could be interrupted"
     proc.send_signal(signal.SIGINT)
-    out, err = proc.communicate(timeout=120)
+    out, err = proc.communicate(timeout=HANG_GUARD_S)
     assert proc.returncode != 0 and "run the same command again to resume" in err
-    res = subprocess.run(argv + ["--json"], capture_output=True, text=True, timeout=600)
+    res = subprocess.run(argv + ["--json"], capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert res.returncode == 0, res.stderr
     ref = ep.solve([1, 2, 3], [2000.0], omega0=[1, 0.1, 0.5], method="taylor")
     state = json.loads(res.stdout)

@@ -190,7 +190,7 @@ def test_chart_segments_linear_time():
     segs = plots.chart_segments(q)
     elapsed = time.perf_counter() - start
     assert len(segs) > 10_000
-    assert elapsed < 10.0, elapsed
+    assert elapsed < 60.0, elapsed  # about 2 s quiet (0.5 s compiled and warm); the quadratic split took minutes
     b_np = plots._chart_bounds_numpy(q / np.linalg.norm(q, axis=1, keepdims=True), 1.0, 4.0)
     assert b_np == [(int(i[0]), int(i[-1]) + 1) for i, _, _ in segs]
 
@@ -200,7 +200,7 @@ def test_gibbs_of_a_long_run_draws_a_bounded_number_of_charts():
     tr = ep.solve(I, t, omega0=[2.0, 0.2, 1.0])
     start = time.perf_counter()
     fig = plots.plot_gibbs(tr)
-    assert time.perf_counter() - start < 30.0
+    assert time.perf_counter() - start < 60.0  # about 2 s quiet: a guard against the unbounded drawing, not a timing
     ax = fig.axes[0]
     texts = [tx.get_text() for tx in ax.texts]
     assert any("charts drawn" in s for s in texts), texts

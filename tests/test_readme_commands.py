@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from _limits import HANG_GUARD_S
+
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 EXE = str(Path(sys.executable).with_name("eulerpoisson"))
@@ -45,7 +47,9 @@ def test_readme_commands_run_top_to_bottom(tmp_path):
     for cmd in COMMANDS:
         cmd = cmd.replace("--samples 100000000", "--samples 20000")
         argv = shlex.split(cmd)
-        res = subprocess.run([EXE, *argv[1:]], cwd=tmp_path, capture_output=True, text=True, timeout=300, env=env)
+        res = subprocess.run(
+            [EXE, *argv[1:]], cwd=tmp_path, capture_output=True, text=True, timeout=HANG_GUARD_S, env=env
+        )
         assert res.returncode == 0, f"{cmd}\n{res.stderr}"
         assert "Traceback" not in res.stderr, cmd
     for name in (

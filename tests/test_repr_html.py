@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from eulerpoisson.util import htmlrepr
 
 #: elements that never have an end tag
@@ -159,7 +160,7 @@ def test_no_matplotlib():
         "ep.RigidBody([1.0, 2.0, 2.5])._repr_html_(); ep.Model([1, 2, 2.5])._repr_html_()\n"
         "assert 'matplotlib' not in sys.modules, 'matplotlib imported'\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert out.returncode == 0, out.stderr
 
 

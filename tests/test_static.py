@@ -17,10 +17,12 @@ from pathlib import Path
 
 import pytest
 
+from _limits import HANG_GUARD_S
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _run(module: str, *args: str, timeout: float = 600) -> subprocess.CompletedProcess:
+def _run(module: str, *args: str, timeout: float = HANG_GUARD_S) -> subprocess.CompletedProcess:
     if importlib.util.find_spec(module) is None:
         pytest.skip(f"{module} is not installed (it comes with the 'test' extra: pip install -e '.[test]')")
     return subprocess.run(

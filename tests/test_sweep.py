@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from _limits import HANG_GUARD_S
+
 pytest.importorskip("zarr")
 pytest.importorskip("xarray")
 distributed = pytest.importorskip("distributed")
@@ -400,14 +402,14 @@ def test_killed_sweep_resumes_on_the_cluster(tmp_path, cluster, reference):
     script.write_text(CHILD)
     proc = subprocess.Popen([sys.executable, str(script), str(toml), str(tmp_path)], cwd=tmp_path)
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + HANG_GUARD_S  # a guard against a hang, not a timing
         while not (tmp_path / "sleeping-2").exists():
             assert proc.poll() is None, "the child sweep ended early"
             assert time.monotonic() < deadline
             time.sleep(0.05)
     finally:
         os.kill(proc.pid, signal.SIGKILL)
-        proc.wait()
+        proc.wait(timeout=HANG_GUARD_S)
     work = tmp_path / ".atlas.zarr.partial"
     assert sorted(p.name for p in (work / "done").iterdir()) == ["000000000", "000000001"]
     before = load_sweep(work / "store.zarr")["chunk_time"].values[:2].copy()

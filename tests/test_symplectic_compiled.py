@@ -16,6 +16,7 @@ import textwrap
 import numpy as np
 import pytest
 
+from _limits import HANG_GUARD_S
 from _markers import needs_numba
 from eulerpoisson import EulerPoissonError
 from eulerpoisson.solvers import charts as ch
@@ -197,7 +198,7 @@ def test_no_numba_subprocess_matches(tmp_path):
         env=env,
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_GUARD_S,
     )
     assert res.returncode == 0, res.stderr
     flags = json.loads(res.stdout.strip().splitlines()[-1])

@@ -17,6 +17,7 @@ import sys
 import numpy as np
 import pytest
 
+from _limits import HANG_GUARD_S
 from _reference import _qmul as ref_qmul
 from _reference import quaternion_distance, reference_motion
 from eulerpoisson import Attitude, RigidBody
@@ -615,7 +616,7 @@ def test_lane_kernel_logic_equals_scalar_kernel_bit_for_bit_in_python():
         env=env,
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_GUARD_S,
         check=True,
     )
     res = json.loads(out.stdout.strip().splitlines()[-1])
@@ -693,7 +694,7 @@ def test_numpy_fallback_in_subprocess_matches():
         env=env,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_GUARD_S,
         check=True,
     )
     res = json.loads(out.stdout.strip().splitlines()[-1])

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 import eulerpoisson as ep
+from _limits import HANG_GUARD_S
 from eulerpoisson.errors import EulerPoissonError, InvalidInputError
 from eulerpoisson.solvers import get_method, parallel
 from eulerpoisson.util.jit import USE_NUMBA
@@ -157,7 +158,7 @@ def test_chunks_run_in_concurrent_threads(split_everything, monkeypatch):
     """Two chunks, two workers: both threads are inside the method at once (a barrier both must reach)."""
     cls = get_method("exact")
     original = cls.run
-    barrier = threading.Barrier(2, timeout=120)  # a guard against a hang, not a timing
+    barrier = threading.Barrier(2, timeout=HANG_GUARD_S)  # a guard against a hang, not a timing
     seen = set()
     lock = threading.Lock()
 
@@ -308,7 +309,7 @@ def test_a_forked_child_gets_a_pool_of_its_own(split_everything):
             code = 0 if tr.stats["threads"] == 2 and np.array_equal(tr.quaternion, ref.quaternion) else 1
         finally:
             os._exit(code)
-    deadline = time.monotonic() + 120  # a guard against a hang, not a timing
+    deadline = time.monotonic() + HANG_GUARD_S  # a guard against a hang, not a timing
     while True:
         done, status = os.waitpid(pid, os.WNOHANG)
         if done:

@@ -18,6 +18,7 @@ __all__ = [
     "UsageError",
     "OutputError",
     "FitInputError",
+    "PoorFitError",
     "AuditError",
 ]
 
@@ -182,3 +183,24 @@ class FitInputError(InvalidInputError):
 
 class OutputError(EulerPoissonError, FileExistsError):
     """An output that may not be written: it exists (no overwrite), is an input, is of another kind, or is locked."""
+
+
+class PoorFitError(FitInputError):
+    """A fit far from its data: the reduced chi2 is absurd, or a converted reading of the data fits far better.
+
+    Raised by :func:`eulerpoisson.fit` unless ``accept_poor_fit=True`` (the
+    command line: ``--accept-poor-fit``). ``result`` holds the
+    :class:`~eulerpoisson.estimation.FitResult` that was refused, and
+    ``result.convention_hint`` the reading that fits better, if any.
+
+    Examples
+    --------
+    >>> import eulerpoisson as ep
+    >>> from eulerpoisson.errors import FitInputError, PoorFitError
+    >>> issubclass(PoorFitError, FitInputError), issubclass(PoorFitError, ValueError)
+    (True, True)
+    """
+
+    def __init__(self, message: str, result=None):
+        super().__init__(message)
+        self.result = result

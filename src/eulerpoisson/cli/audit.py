@@ -10,24 +10,25 @@ __all__ = ["add_commands", "cmd_audit"]
 
 
 def cmd_audit(args) -> int:
-    from ..paper.audit import run_audit, write_report
+    from ..paper.audit import run_audit
 
     check_file_name(args.out, "--out")
-    if args.out is not None:
-        from ..io.outputs import check_output
-
-        check_output(args.out, "file", overwrite=bool(args.overwrite))  # before the 25 s of the audit
-    report = run_audit()
-    if args.out is not None:
-        from ..io.outputs import OutputLock
-
-        with OutputLock(args.out):
-            write_report(report, args.format, args.out)
-        if not args.quiet:
-            print(f"wrote {args.out}")
-    else:
+    if args.out is None:
+        report = run_audit()
         text = {"md": report.to_markdown, "json": report.to_json, "tex": report.to_latex}[args.format]()
         print(text)
+        return 0
+    from ..io.atomic import atomic_write_text
+    from ..io.outputs import claim_output, mark_text
+
+    # claimed before the 25 s of the audit: a second writer is refused at once, a file that appears meanwhile
+    # is not replaced; --overwrite replaces only an audit report of ours (recognized by its marker)
+    with claim_output(args.out, "audit-report", overwrite=bool(args.overwrite), option="--out"):
+        report = run_audit()
+        text = {"md": report.to_markdown, "json": report.to_json, "tex": report.to_latex}[args.format]()
+        atomic_write_text(args.out, mark_text(text, "audit-report", args.format))
+    if not args.quiet:
+        print(f"wrote {args.out}")
     return 0
 
 
@@ -43,7 +44,7 @@ def add_commands(sub) -> None:
     a.add_argument("--format", choices=["md", "json", "tex"], default="md", help="report format (default md)")
     a.add_argument("--out", help="write the report to this file instead of printing it")
     a.add_argument(
-        "--overwrite", action="store_true", help="replace an existing report file (never a file of another kind)"
+        "--overwrite", action="store_true", help="replace an audit report written before (never a file of another kind)"
     )
     a.add_argument("--quiet", action="store_true")
     a.set_defaults(func=cmd_audit)

@@ -2,13 +2,17 @@
 
 The usage error and its exit status, the one-line-error argument parser,
 the parsing of numbers, inertia tensors, file names and TOML files, the
-reading of a trajectory file and the one-line text of an exception.
+reading of a trajectory file, the one-line text of an exception, strict
+JSON (:func:`json_text`) and the range checks of a run's scales
+(:func:`check_run_scales`).
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import json
+import math
 import os
 from pathlib import Path
 
@@ -27,16 +31,25 @@ __all__ = [
     "naming_target",
     "read_trajectory",
     "error_message",
+    "json_text",
+    "check_run_scales",
 ]
 
 EXIT_USAGE = 2
 
 
 class Parser(argparse.ArgumentParser):
-    """ArgumentParser whose errors are one line and exit status 2."""
+    """ArgumentParser whose errors are one line and exit status 2.
+
+    The line names the subcommand once (the program's name starts every
+    error line already): ``eulerpoisson: error: simulate: argument --t-end:
+    expected one argument (see 'eulerpoisson simulate --help')``.
+    """
 
     def error(self, message):  # noqa: D401 - argparse API
-        raise UsageError(f"{self.prog}: {message} (see '{self.prog} --help')")
+        command = self.prog.partition(" ")[2]  # "eulerpoisson simulate" -> "simulate"; "eulerpoisson" -> ""
+        where = f"{command}: " if command else ""
+        raise UsageError(f"{where}{message} (see '{self.prog} --help')")
 
 
 # ---------------------------------------------------------------------------
@@ -166,3 +179,179 @@ def error_message(exc: BaseException) -> str:
         if line.strip():
             return line.strip()
     return type(exc).__name__
+
+
+# ---------------------------------------------------------------------------
+# strict JSON
+# ---------------------------------------------------------------------------
+def _strict(x, where: str, reasons: dict[str, str]):
+    """``x`` as plain JSON values; a non-finite float becomes None and its path goes to ``reasons``."""
+    if isinstance(x, dict):
+        return {str(k): _strict(v, f"{where}.{k}" if where else str(k), reasons) for k, v in x.items()}
+    if isinstance(x, np.ndarray):
+        x = x.tolist()
+    if isinstance(x, (list, tuple)):
+        return [_strict(v, f"{where}[{i}]", reasons) for i, v in enumerate(x)]
+    if isinstance(x, (bool, np.bool_)):
+        return bool(x)
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, (float, np.floating)):
+        v = float(x)
+        if math.isfinite(v):
+            return v
+        reasons[where] = "NaN: undefined in float64" if math.isnan(v) else f"{v}: overflows float64"
+        return None
+    return x
+
+
+def json_text(obj) -> str:
+    """``obj`` as one line of strict JSON (RFC 8259: no ``NaN`` nor ``Infinity``).
+
+    A value that is not a finite number is written ``null``, and the object
+    gets a ``"non_finite"`` entry that says, for each such value (by its path),
+    why it is null. NumPy scalars and arrays become plain numbers and lists.
+
+    Examples
+    --------
+    >>> from eulerpoisson.cli.common import json_text
+    >>> print(json_text({"energy": 1.5, "drift": {"m_norm": float("nan")}, "m": [1e308, float("inf")]}))
+    {"energy": 1.5, "drift": {"m_norm": null}, "m": [1e+308, null], "non_finite": {"drift.m_norm": "NaN: ...", ...}}
+    """
+    reasons: dict[str, str] = {}
+    clean = _strict(obj, "", reasons)
+    if reasons:
+        if isinstance(clean, dict):
+            clean["non_finite"] = reasons
+        else:
+            clean = {"value": clean, "non_finite": reasons}
+    return json.dumps(clean, allow_nan=False)
+
+
+# ---------------------------------------------------------------------------
+# the scales of a run: what float64 can hold and follow
+# ---------------------------------------------------------------------------
+#: the largest |m| whose square (the invariant |m|^2) is a float64 number
+MAX_MOMENTUM = math.sqrt(np.finfo(float).max)
+
+
+def _norms(a, axes: int | tuple[int, int] = -1) -> np.ndarray:
+    """Euclidean (Frobenius) norms over ``axes`` without overflow in the squares (inf only when the norm is)."""
+    a = np.abs(np.asarray(a, dtype=float))
+    top = np.max(a, axis=axes, keepdims=True)
+    safe = np.where(top > 0, top, 1.0)
+    return (
+        np.squeeze(safe, axis=axes) * np.sqrt(np.sum(np.square(a / safe), axis=axes)) * (np.squeeze(top, axis=axes) > 0)
+    )
+
+
+def _torque_bound(tq, inertia_max: float) -> float | None:
+    """An upper bound of |torque| over every attitude (None: unknown, e.g. a Python function)."""
+    try:
+        poly = tq.polynomial()
+    except Exception:  # noqa: BLE001 - a torque without a usable polynomial form: no bound
+        return None
+    if poly is None:
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        bound = float(np.max(_norms(poly.constant), initial=0.0))
+        for s, L in zip(poly.vectors, poly.maps):
+            bound += float(np.max(_norms(s) * _norms(L, (-2, -1)), initial=0.0))
+        bound += float(np.max(np.abs(np.asarray(poly.orbit_gain, dtype=float)), initial=0.0)) * inertia_max
+    return bound if not math.isnan(bound) else math.inf
+
+
+def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
+    """Refuse a run whose numbers float64 cannot hold or follow, before it starts; the message names the flags.
+
+    - The invariants: the energy ``1/2 omega.I omega`` and ``|m|^2`` must be
+      float64 numbers: ``|m| = |I omega|`` below 1.3e154 (``--inertia`` with
+      ``--omega`` or ``--m``).
+    - A torque (``--gravity``, ``--com``, ...) too strong to follow: the rates
+      it can drive (by the energy for a conservative torque, growing with the
+      time for another one) must not turn the body through more than
+      2^48 rad by ``t_end``, the range of the closed form too (a float64
+      phase beyond it is noise), nor overflow.
+
+    ``name(key)`` is the flag or ``file: [section] key`` of a configuration key.
+
+    Raises
+    ------
+    UsageError
+        With the values, the range and the flags to change.
+
+    Examples
+    --------
+    >>> from eulerpoisson import Model, RigidBody
+    >>> from eulerpoisson.cli.common import check_run_scales
+    >>> from eulerpoisson.cli.config import namer
+    >>> model = Model(RigidBody([1e308, 1e308, 1e308]))
+    >>> try:
+    ...     check_run_scales(model, [1.0, 0.1, 0.5], None, None, 1.0, namer({}))
+    ... except UsageError as err:
+    ...     print(err)
+    the angular momentum |m| = |I omega| = 1.12e+308 of --inertia and --omega overflows float64 ...
+    """
+    from ..attitude.core import Attitude
+    from ..solvers.exact.method import MAX_PHASE
+
+    body = model.body
+    inertia = np.asarray(body.inertia, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        if omega0 is not None:
+            w = np.asarray(omega0, dtype=float)
+            M = np.einsum("...ij,...j->...i", inertia, w)
+            given = name("initial.omega")
+        else:
+            R0 = Attitude(q0).as_matrix() if q0 is not None else np.eye(3)
+            M = np.einsum("...ji,...j->...i", R0, np.asarray(m0, dtype=float))
+            w = np.einsum("...ij,...j->...i", np.asarray(body.inertia_inv, dtype=float), M)
+            given = name("initial.m")
+        m_norm = float(np.max(_norms(M), initial=0.0))
+        energy = float(np.max(0.5 * np.sum(w * M, axis=-1), initial=0.0))
+        w_norm = float(np.max(_norms(w), initial=0.0))
+    if not (m_norm < MAX_MOMENTUM and math.isfinite(energy) and math.isfinite(w_norm)):
+        raise UsageError(
+            f"the angular momentum |m| = |I omega| = {m_norm:.3g} of {name('body.inertia')} and {given} overflows "
+            f"float64 (its square |m|^2, an invariant of the motion, or the energy 1/2 omega.I omega = {energy:.3g} "
+            f"is not a number): keep |I omega| below {MAX_MOMENTUM:.2g} and the energy below "
+            f"{np.finfo(float).max:.2g}; write the inertia and the rates in other units"
+        )
+    if not model.torques or t_end == 0.0:
+        return
+    moments = np.asarray(body.principal_moments, dtype=float)
+    i_min, i_max = float(np.min(moments)), float(np.max(moments))
+    if not i_min > 0.0:
+        return  # refused by the body already
+    ratio = math.sqrt(i_max / i_min)
+    with np.errstate(over="ignore", invalid="ignore"):
+        conservative, driven = 0.0, 0.0
+        strongest, strongest_bound = None, -1.0
+        for tq in model.torques:
+            bound = _torque_bound(tq, i_max)
+            if bound is None:
+                continue
+            if bound > strongest_bound:
+                strongest, strongest_bound = tq, bound
+            if getattr(tq, "conservative", False) and not getattr(tq, "time_dependent", False):
+                conservative += bound
+            else:
+                driven += bound
+        # energy: 1/2 I_min w^2 <= 1/2 I_max |w0|^2 + (the range of the potential, at most 2 |tau|max)
+        rate = w_norm * ratio + 2.0 * math.sqrt(conservative / i_min) + driven * abs(t_end) / i_min
+        phase = rate * abs(t_end)
+    if strongest is None or (math.isfinite(phase) and phase <= MAX_PHASE):
+        return
+    flags = [name(f"torque.{p.toml_key}") for p in type(strongest).cli] or [repr(strongest)]
+    if not math.isfinite(strongest_bound):
+        raise UsageError(
+            f"the torque {strongest.kind.replace('_', ' ')} ({', '.join(flags)}) overflows float64: the product of "
+            f"its parameters is not a number (above {np.finfo(float).max:.2g}); use smaller values"
+        )
+    raise UsageError(
+        f"the torque {strongest.kind.replace('_', ' ')} ({', '.join(flags)}) is too strong for float64: up to "
+        f"{strongest_bound:.3g} on a smallest moment of inertia {i_min:.3g}, it drives the rates to about "
+        f"{rate:.3g} rad/s, and by |t| = {abs(t_end):g} the body would turn through {phase:.3g} rad, beyond the "
+        f"2^48 = {MAX_PHASE:.3g} rad over which float64 can follow the motion (the rounding of each step shifts "
+        f"it by more than 0.1 rad); use a weaker torque or a shorter {name('time.t_end')}"
+    )

@@ -10,10 +10,12 @@ exit status 2.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import functools
 import math
 import os
 
-from .common import UsageError
+from .common import UsageError, json_text
 
 __all__ = ["add_commands", "cmd_fit", "FIT_EXAMPLES"]
 
@@ -63,16 +65,49 @@ def _inertia(text):
     return np.array(v) if len(v) == 3 else np.array(v).reshape(3, 3)
 
 
-def cmd_fit(args) -> int:
-    import json
+def _reading_flag(res, args):
+    """The flag that reads the data as ``res.better_reading`` (relative to the flags given), or None."""
+    reading = res.better_reading
+    if reading == "conjugate":
+        now = args.attitude_convention or "body-to-space"
+        return "--attitude-convention " + ("space-to-body" if now == "body-to-space" else "body-to-space")
+    return {
+        "xyzw": "--quaternion-order xyzw",
+        "space": "--omega-frame space",
+        "body": "--omega-frame body",
+        "deg": "--omega-unit deg",
+    }.get(reading)
 
+
+def _poor_fit_line(res, args):
+    """One line for a refused fit: why, the flag that reads the data better, and --accept-poor-fit."""
+    from ..estimation.data import POOR_FIT_CHI2
+
+    flag = _reading_flag(res, args)
+    why = res.reading_advice(flag) if flag is not None else None
+    if why is None:
+        why = (
+            f"reduced chi2 = {res.reduced_chi2:.4g} > {POOR_FIT_CHI2:g}: check the sigmas (--sigma-attitude, "
+            "--sigma-omega, --sigma-axis) and the conventions (--quaternion-order, --attitude-convention, "
+            "--omega-frame, --omega-unit)"
+        )
+    return f"poor fit: {why} (or --accept-poor-fit to keep this fit)"
+
+
+def cmd_fit(args) -> int:
+    from ..errors import PoorFitError
     from ..estimation import fit
+    from ..io.atomic import atomic_write_text, guard_replace
     from ..io.observations import read_observations
-    from ..io.outputs import check_output
+    from ..io.outputs import OutputLock, check_output, check_output_name, claim_output, mark_text
 
     for value, name in ((args.file, "observations file"), (args.out, "--out"), (args.plot, "--plot")):
         if value is not None and not str(value).strip():
             raise UsageError(f"{name}: empty file name")
+    if args.out is not None:
+        check_output_name(args.out, "--out")
+    if args.plot is not None:
+        check_output_name(args.plot, "--plot", folder=True)
     if not os.path.exists(args.file):
         raise UsageError(f"{args.file}: no such file (observations: .csv, .nc or .toml)")
     obs = read_observations(
@@ -82,14 +117,18 @@ def cmd_fit(args) -> int:
         sigma_axis_deg=_positive(args.sigma_axis, "--sigma-axis"),
         omega_frame=args.omega_frame,
         axis=_vector(args.axis, "--axis"),
+        quaternion_order=args.quaternion_order,
+        attitude_convention=args.attitude_convention,
+        omega_unit=args.omega_unit,
     )
     kwargs = obs.fit_kwargs()
+    rate_unit = args.omega_unit or "rad"  # out in the units of the flags: degrees for angles, the rates' unit
     if args.principal_axes is not None:
         kwargs["principal_axes"] = args.principal_axes
     if args.inertia is not None:
         kwargs["inertia"] = _inertia(args.inertia)
-    if args.out is not None:
-        check_output(args.out, "file", overwrite=bool(args.overwrite), inputs=[args.file])
+    # every file read is an input (the TOML and the data file it names): never an output, even with --overwrite
+    inputs = [args.file, *obs.files]
     if args.plot is not None:
         if os.path.exists(args.plot) and not os.path.isdir(args.plot):
             raise UsageError(f"--plot {args.plot!r} is a file; give a folder for the figures")
@@ -98,16 +137,35 @@ def cmd_fit(args) -> int:
             raise UsageError(
                 f"--plot {args.plot!r} already holds {', '.join(clash)}; run again with --overwrite to replace them"
             )
-    t = kwargs.pop("t")
-    res = fit(t, **kwargs)
-    if args.out is not None:
-        res.to_json(args.out)
-    written = res.save_plots(args.plot) if args.plot is not None else []
+    # the outputs are claimed (checked and locked) before the fit and checked again before each rename
+    with contextlib.ExitStack() as claims:
+        if args.out is not None:
+            claims.enter_context(
+                claim_output(args.out, "fit-result", overwrite=bool(args.overwrite), inputs=inputs, option="--out")
+            )
+        if args.plot is not None:  # the folder is locked; each figure is checked now and before its rename
+            claims.enter_context(OutputLock(args.plot))
+            for f in PLOT_FILES:
+                fig = os.path.join(args.plot, f)
+                check = functools.partial(
+                    check_output, fig, "figure", overwrite=bool(args.overwrite), inputs=inputs, option="--plot"
+                )
+                check()
+                claims.enter_context(guard_replace(fig, check))
+        t = kwargs.pop("t")
+        try:
+            res = fit(t, **kwargs, accept_poor_fit=bool(args.accept_poor_fit))
+        except PoorFitError as exc:
+            raise UsageError(f"{obs.source}: {_poor_fit_line(exc.result, args)}") from None
+        if args.out is not None:
+            text = res.to_json(angle_unit="deg", rate_unit=rate_unit)  # the sigmas in the flags' units
+            atomic_write_text(args.out, mark_text(text, "fit-result", "json"))
+        written = res.save_plots(args.plot) if args.plot is not None else []
     if args.json:
-        print(json.dumps(res.as_dict()))
+        print(json_text(res.as_dict(angle_unit="deg", rate_unit=rate_unit)))  # strict JSON (issue 22)
     else:
         print(f"{obs.source}:")
-        print(res.summary())
+        print(res.summary(angle_unit="deg", rate_unit=rate_unit, flag=_reading_flag(res, args)))
         for p in ([args.out] if args.out else []) + [str(w) for w in written]:
             print(f"  wrote {p}")
     return 0
@@ -144,7 +202,7 @@ def add_commands(sub) -> None:
         "--sigma-omega",
         dest="sigma_omega",
         metavar="RATE",
-        help="standard deviation of each angular-velocity component (the file's units)",
+        help="standard deviation of each angular-velocity component, in the unit of the rates (--omega-unit)",
     )
     f.add_argument(
         "--sigma-axis", dest="sigma_axis", metavar="DEG", help="standard deviation of the axis directions, degrees"
@@ -154,6 +212,24 @@ def add_commands(sub) -> None:
         dest="omega_frame",
         choices=("body", "space"),
         help="frame of wx,wy,wz (default body, or the file's)",
+    )
+    f.add_argument(
+        "--omega-unit",
+        dest="omega_unit",
+        choices=("rad", "deg"),
+        help="unit of wx,wy,wz and of their sigmas (--sigma-omega): radians (default) or degrees per unit of t",
+    )
+    f.add_argument(
+        "--quaternion-order",
+        dest="quaternion_order",
+        choices=("wxyz", "xyzw"),
+        help="what the quaternion columns hold in file order: scalar first or last (default: as the names say)",
+    )
+    f.add_argument(
+        "--attitude-convention",
+        dest="attitude_convention",
+        choices=("body-to-space", "space-to-body"),
+        help="what the attitudes rotate (default body-to-space: x_space = R x_body)",
     )
     f.add_argument("--axis", metavar="X,Y,Z", help="the body axis whose space direction ax,ay,az is observed")
     f.add_argument(
@@ -165,6 +241,12 @@ def add_commands(sub) -> None:
     f.add_argument("--inertia", help="fix the inertia (I1,I2,I3 or nine numbers): fit the state only")
     f.add_argument("--out", metavar="FILE", help="write the result as JSON")
     f.add_argument("--plot", metavar="DIR", help="write residuals.png, fit.png and polhode.png into DIR")
+    f.add_argument(
+        "--accept-poor-fit",
+        dest="accept_poor_fit",
+        action="store_true",
+        help="keep a poor fit (reduced chi2 > 100, or another reading of the data fits far better) instead of exit 2",
+    )
     f.add_argument("--json", action="store_true", help="print the result as one JSON object instead of the summary")
     f.add_argument("--overwrite", action="store_true", help="replace an existing --out file or --plot figures")
     f.set_defaults(func=cmd_fit)

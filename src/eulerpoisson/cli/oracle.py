@@ -8,12 +8,12 @@ from unit norm, ...); a likely convention mismatch is named in its message.
 from __future__ import annotations
 
 import argparse
-import json
+import contextlib
 import math
 import os
 import sys
 
-from .common import UsageError, check_file_name, inertia_from
+from .common import UsageError, check_file_name, inertia_from, json_text
 
 __all__ = ["add_commands", "cmd_validate", "cmd_cases"]
 
@@ -52,22 +52,13 @@ def _fmt_times(xs, n=6):
     return s + (f", ... ({len(xs)} in all)" if len(xs) > n else "")
 
 
-def cmd_validate(args) -> int:
+def _validate(args, inertia, tol):
+    """The report of ``validate``; bad input is a UsageError (one line)."""
     from ..errors import InvalidInputError
     from ..oracle import validate
 
-    check_file_name(args.run, "run file")
-    check_file_name(args.plot, "--plot")
-    inertia = inertia_from(args.inertia) if args.inertia is not None else None
-    tol = _tolerance(args.tolerance)
-    if not os.path.exists(args.run):
-        raise UsageError(f"{args.run}: no such file (a run: .csv with header t,qw,qx,qy,qz,wx,wy,wz, .nc or .json)")
-    if args.plot:
-        from ..io.outputs import check_output
-
-        check_output(args.plot, "file", overwrite=bool(args.overwrite), inputs=[args.run])
     try:
-        rep = validate(
+        return validate(
             args.run,
             inertia,
             quaternion_order=args.quaternion_order,
@@ -80,14 +71,39 @@ def cmd_validate(args) -> int:
         if "the run does not state it" in msg:
             raise UsageError(f"{args.run}: give the body's inertia with --inertia I1,I2,I3 (or nine numbers)") from None
         raise UsageError(msg) from None
+
+
+def cmd_validate(args) -> int:
+    check_file_name(args.run, "run file")
+    check_file_name(args.plot, "--plot")
+    inertia = inertia_from(args.inertia) if args.inertia is not None else None
+    tol = _tolerance(args.tolerance)
+    if not os.path.exists(args.run):
+        raise UsageError(f"{args.run}: no such file (a run: .csv with header t,qw,qx,qy,qz,wx,wy,wz, .nc or .json)")
+    claim = contextlib.ExitStack()
+    if args.plot:
+        from ..io.outputs import check_output, claim_output
+
+        check_output(args.plot, "figure", overwrite=bool(args.overwrite), inputs=[args.run], option="--plot")
+        ext = os.path.splitext(args.plot)[1].lower()
+        if ext not in (".png", ".svg", ".pdf"):
+            raise UsageError(f"--plot {args.plot!r}: use a .png, .svg or .pdf file name")
+        # claimed before the comparison: a second writer is refused, a file that appears meanwhile is kept
+        claim.enter_context(
+            claim_output(args.plot, "figure", overwrite=bool(args.overwrite), inputs=[args.run], option="--plot")
+        )
+    with claim:
+        rep = _validate(args, inertia, tol)
+        if args.plot:
+            from ..io.atomic import atomic_path
+            from ..oracle import plot_report
+
+            with atomic_path(args.plot, suffix=ext) as tmp:  # drawn next to its name, then renamed
+                plot_report(rep, tmp)
     for w in rep.warnings:
         print(f"eulerpoisson: warning: {w}", file=sys.stderr)
-    if args.plot:
-        from ..oracle import plot_report
-
-        plot_report(rep, args.plot)
     if args.json:
-        print(json.dumps(rep.to_dict()))
+        print(json_text(rep.to_dict()))  # strict JSON: null (and why) for a non-finite value (issue 22)
     else:
         c = rep.conventions
         lines = [
@@ -132,18 +148,13 @@ def cmd_cases(args) -> int:
             )
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         raise UsageError(f"--out {args.out!r} is a file; give a folder")
-    if os.path.isdir(args.out) and os.listdir(args.out):
-        # the output policy: only a folder of cases written before, and only with --overwrite
-        if not os.path.exists(os.path.join(args.out, "cases.json")):
-            raise UsageError(
-                f"--out {args.out!r} is a folder with other files in it, not a folder of cases; "
-                f"give a new or empty folder (--overwrite never replaces it)"
-            )
-        if not args.overwrite:
-            raise UsageError(
-                f"--out {args.out!r} holds cases written before; run again with --overwrite to replace them"
-            )
-    files = write_cases(args.out, names, netcdf=not args.csv_only)
+    from ..io.outputs import claim_output
+
+    # a new or empty folder, or (with --overwrite) a folder of cases written before: claimed before the cases are
+    # computed; they are written aside and moved in at the end (a failure leaves nothing), and the cases of the
+    # folder not written again are removed (--only --overwrite leaves no stale case behind)
+    with claim_output(args.out, "cases", overwrite=bool(args.overwrite), option="--out"):
+        files = write_cases(args.out, names, netcdf=not args.csv_only)
     if not args.quiet:
         print(f"wrote {len(files)} files into {args.out} (README.md lists the cases)")
     return 0

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import argparse
-import json
+import contextlib
 import math
 import os
 import sys
@@ -13,7 +13,7 @@ import numpy as np
 
 from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import EulerPoissonError
-from .common import UsageError, check_file_name, load_toml, naming_target, parse_floats
+from .common import UsageError, check_file_name, check_run_scales, json_text, load_toml, naming_target, parse_floats
 from .config import (
     FLAGS,
     METHOD_OPTIONS,
@@ -140,6 +140,12 @@ def solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, kee
 
 
 def cmd_simulate(args) -> int:
+    # the output is claimed (checked, locked) before the work and held until the command ends
+    with contextlib.ExitStack() as claims:
+        return _simulate(args, claims)
+
+
+def _simulate(args, claims: contextlib.ExitStack) -> int:
     from ..attitude.core import quaternion_from_gibbs
     from ..model.equations import Model
     from ..solvers import available_methods
@@ -264,6 +270,7 @@ def cmd_simulate(args) -> int:
             )
     torques = build_torques(cfg, name)
     model = Model(body, torques)
+    check_run_scales(model, omega0, m0, q0, t_end, name)  # numbers float64 can hold and follow (issue 22)
     # one rule with ep.solve: the most accurate method that can run the model (exact, else taylor, ...)
     from ..solvers.engine import default_method
 
@@ -294,11 +301,14 @@ def cmd_simulate(args) -> int:
         raise UsageError(f"{name('output.file')} {out!r}: use a .nc (NetCDF) or .zarr (streamed) file name")
     if out is not None:
         # one policy for outputs: nothing replaced without --overwrite, never an input or another kind of file
-        from ..io.outputs import OutputLock, check_output
+        # claimed before the work: a second writer is refused at once, and the output is checked again under the
+        # lock and just before the rename (a file that appeared meanwhile is not replaced without --overwrite)
+        from ..io.outputs import claim_output
 
         zarr_out = str(out).endswith(".zarr")
-        check_output(
-            out, "trajectory-store" if zarr_out else "netcdf", overwrite=bool(args.overwrite), inputs=[args.config]
+        kind = "trajectory-store" if zarr_out else "netcdf"
+        claims.enter_context(
+            claim_output(out, kind, overwrite=bool(args.overwrite), inputs=[args.config], option=name("output.file"))
         )
     if out is not None and str(out).endswith(".zarr"):
         # long runs stream to disk chunk by chunk (atomic, resumable); the state at T is read back from the file
@@ -310,7 +320,7 @@ def cmd_simulate(args) -> int:
                 file=sys.stderr,
             )
         start = time.perf_counter()
-        with OutputLock(out), naming_target(out):
+        with naming_target(out):
             try:
                 solve_to_file(
                     model,
@@ -326,11 +336,28 @@ def cmd_simulate(args) -> int:
                     **opts,
                 )
             except KeyboardInterrupt:
-                print(
-                    f"eulerpoisson: interrupted; the finished chunks of {out} are kept: run the same command "
-                    f"again to resume",
-                    file=sys.stderr,
-                )
+                # name the folder that really holds the chunks, and the command that resumes (never --overwrite:
+                # it starts afresh); the command line is known when this runs as the `eulerpoisson` program
+                import shlex
+
+                kept = partial_store(out)
+                argv = sys.argv[1:] if os.path.basename(sys.argv[0] or "").startswith("eulerpoisson") else []
+                again = [a for a in argv if a != "--overwrite"]
+                how = "run the same command again" + (" without --overwrite" if args.overwrite else "") + " to resume"
+                cmd = f": {shlex.join(['eulerpoisson', *again])}" if again else ""
+                if not kept.exists():
+                    msg = f"eulerpoisson: interrupted before any chunk of {out} was finished; nothing was kept"
+                elif args.overwrite and os.path.exists(out):
+                    msg = (
+                        f"eulerpoisson: interrupted; the finished chunks are kept in {kept} (a hidden folder next "
+                        f"to {out}, which is unchanged); remove {out} and {how}{cmd}"
+                    )
+                else:
+                    msg = (
+                        f"eulerpoisson: interrupted; the finished chunks are kept in {kept} (a hidden folder next "
+                        f"to {out}); {how}{cmd}"
+                    )
+                print(msg, file=sys.stderr)
                 raise
             except EulerPoissonError as exc:
                 raise type(exc)(
@@ -348,12 +375,11 @@ def cmd_simulate(args) -> int:
             traj, drift = solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, keep=False)
         else:
             traj = solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress)
-            with OutputLock(out):
-                traj.to_netcdf(out)
+            traj.to_netcdf(out)
     if out is not None:
         drift = traj.drift()
     if as_json:
-        print(json.dumps(_state_json(traj, drift)))
+        print(json_text(_state_json(traj, drift)))  # strict JSON: null (and why) for a non-finite value
     elif not args.quiet:
         s = _state_json(traj, drift)
         print(f"{traj.method}: {samples} samples to t = {t_end:g}, wall time {traj.stats.get('wall_time', 0.0):.3g} s")

@@ -7,8 +7,9 @@ calibrated uncertainties; :class:`FitResult` holds the answer, its
 covariance, residuals, the distinct optima found, the prediction and plots.
 """
 
+from ..errors import PoorFitError
 from .data import FitInputError
 from .estimate import fit
 from .result import FitResult, LocalOptimum
 
-__all__ = ["fit", "FitResult", "LocalOptimum", "FitInputError"]
+__all__ = ["fit", "FitResult", "LocalOptimum", "FitInputError", "PoorFitError"]

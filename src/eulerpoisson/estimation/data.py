@@ -29,10 +29,22 @@ from ..attitude.core import Attitude, quaternion_from_scipy
 from ..errors import FitInputError, InvalidInputError
 from ..util.validate import as_float_array
 
-__all__ = ["ObservationSet", "observation_set", "quaternion_array", "FitInputError"]
+__all__ = [
+    "ObservationSet",
+    "observation_set",
+    "quaternion_array",
+    "FitInputError",
+    "READINGS",
+    "reading_hint",
+    "POOR_FIT_CHI2",
+]
 
 #: norm tolerance of observed unit quaternions and directions (as everywhere in the package)
 UNIT_TOL = 1e-6
+
+#: other readings of the same numbers (:meth:`ObservationSet.reread`): scalar-last quaternions, their conjugates
+#: (space to body), the rates in the other frame, the rates in degrees per unit of t
+READINGS = ("xyzw", "conjugate", "space", "body", "deg")
 
 
 @dataclass(frozen=True)
@@ -103,6 +115,36 @@ class ObservationSet:
             om_sigma=self.om_sigma * scale.get("omega", 1.0),
             ax_sigma=self.ax_sigma * scale.get("axis", 1.0),
         )
+
+    def readings(self) -> tuple[str, ...]:
+        """The other readings of these numbers that :meth:`reread` gives, among :data:`READINGS`."""
+        out = []
+        if len(self.att_idx):
+            out += ["xyzw", "conjugate"]
+        if len(self.om_idx):
+            out += ["space" if self.omega_frame == "body" else "body", "deg"]
+        return tuple(out)
+
+    def reread(self, reading: str) -> ObservationSet:
+        """The same numbers read another way (sigmas follow their observations).
+
+        ``"xyzw"``: the quaternions were scalar last (x, y, z, w);
+        ``"conjugate"``: they were the inverse rotations (space to body);
+        ``"space"``/``"body"``: the rates were in that frame; ``"deg"``: the
+        rates (and their sigmas) were in degrees per unit of ``t``.
+        """
+        from dataclasses import replace
+
+        if reading not in self.readings():
+            raise FitInputError(f"reading must be one of {', '.join(self.readings())}; got {reading!r}")
+        if reading == "xyzw":
+            return replace(self, att_q=self.att_q[:, [3, 0, 1, 2]])
+        if reading == "conjugate":
+            return replace(self, att_q=self.att_q * np.array([1.0, -1.0, -1.0, -1.0]))
+        if reading == "deg":
+            k = np.pi / 180.0
+            return replace(self, om_value=self.om_value * k, om_sigma=self.om_sigma * k)
+        return replace(self, omega_frame=reading)
 
     def window(self, t_end: float) -> ObservationSet:
         """The observations at times up to ``t_end`` (the times array itself is kept)."""
@@ -285,3 +327,53 @@ def observation_set(
     if not obs.kinds:
         raise FitInputError("no observations: give attitude, omega or axis_direction (rows of NaN are missing ones)")
     return obs
+
+
+#: a reduced chi2 above this is absurd: ``fit`` refuses the result unless ``accept_poor_fit=True``
+POOR_FIT_CHI2 = 100.0
+
+#: per reading (:meth:`ObservationSet.reread`): what the data look like, what to do in the API, on the command line
+READING_TEXT = {
+    "xyzw": (
+        "the quaternions look scalar-last (x, y, z, w)",
+        "reorder them to (w, x, y, z)",
+        "--quaternion-order xyzw",
+    ),
+    "conjugate": (
+        "the attitudes look space-to-body (the conjugate quaternions)",
+        "conjugate them",
+        "--attitude-convention space-to-body",
+    ),
+    "space": ("the angular velocities look space-frame", "pass omega_frame='space'", "--omega-frame space"),
+    "body": ("the angular velocities look body-frame", "pass omega_frame='body'", "--omega-frame body"),
+    "deg": (
+        "the angular velocities look like degrees per unit of t",
+        "multiply them by pi/180",
+        "--omega-unit deg",
+    ),
+}
+
+
+def reading_hint(
+    reading: str, reduced: float, better: float, *, detail: str | None = None, flag: str | None = None
+) -> str:
+    """One line: the data read as ``reading`` fit far better, and what to do (``flag``: only the command line's).
+
+    ``reduced`` and ``better``: the reduced chi2 of the fit and of the other reading, with the same sigmas;
+    ``detail``: what got better (default: the residuals, from the two).
+
+    Examples
+    --------
+    >>> print(reading_hint("space", 4012.0, 0.98))
+    the angular velocities look space-frame: read so, the data fit far better (residuals 64 times smaller, ...
+    >>> print(reading_hint("space", 4012.0, 0.98, flag="--omega-frame space"))
+    the angular velocities look space-frame: ... (..., reduced chi2 4012 -> 0.98): rerun with --omega-frame space
+    """
+    what, api, cli = READING_TEXT[reading]
+    if detail is None:
+        ratio = float(np.sqrt(reduced / better)) if better > 0 else float("inf")
+        detail = f"residuals {ratio:.3g} times smaller"
+    head = f"{what}: read so, the data fit far better ({detail}, reduced chi2 {reduced:.4g} -> {better:.4g})"
+    if flag is not None:
+        return f"{head}: rerun with {flag}"
+    return f"{head}; {api} (command line: {cli})"

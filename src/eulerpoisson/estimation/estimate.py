@@ -27,6 +27,20 @@ Weights
     that kind out of ``N``, ``p`` unknowns): from a first search with unit
     sigmas, then again at the optimum of the search proper until it settles.
 
+Poor fits
+    A fit whose reduced :math:`\chi^2` exceeds :data:`POOR_FIT_CHI2` (100)
+    is refused (:class:`~eulerpoisson.errors.PoorFitError`) unless
+    ``accept_poor_fit=True``. When the fit is poor (reduced :math:`\chi^2`
+    above 10, or an estimated sigma large against the data: above about a
+    degree, or 2% of the rates), the other readings of the same numbers are
+    tried, each from one start with a short search: scalar-last quaternions,
+    their conjugates (space to body), the rates in the other frame, the rates
+    in degrees. One whose :math:`\chi^2` with the same sigmas is 100 times
+    smaller, in all or in one kind of observation, makes the fit poor too,
+    and ``convention_hint`` names it with the flag of the command line.
+    Rates alone in degrees are not told apart (a nearly spherical body fits
+    them).
+
 Uncertainties
     :math:`C = (J^\mathsf TJ)^{-1}` of the whitened Jacobian at the optimum, the
     Cramér–Rao bound of Gaussian errors, calibrated in the tests on data from
@@ -42,9 +56,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, PoorFitError
 from ..numerics.quaternion import CONJUGATE, qmul
-from .data import FitInputError, observation_set, quaternion_array
+from .data import POOR_FIT_CHI2, FitInputError, observation_set, quaternion_array, reading_hint
 from .lm import LMOutcome, levenberg_marquardt
 from .residuals import FitState, Layout, evaluate, inertia_matrix, inertia_valid, log_quaternion
 from .result import FitResult, LocalOptimum
@@ -55,7 +69,7 @@ if TYPE_CHECKING:
     from ..attitude.core import AttitudeLike
     from ..model.body import RigidBody
 
-__all__ = ["fit"]
+__all__ = ["fit", "POOR_FIT_CHI2"]
 
 PRINCIPAL_AXES = ("given", "fit")
 
@@ -207,6 +221,7 @@ def fit(
     principal_axes: str = "given",
     initial: Mapping[str, ArrayLike] | None = None,
     max_iter: int = 200,
+    accept_poor_fit: bool = False,
 ) -> FitResult:
     r"""Fit a torque-free rigid body to observations of its rotation: inertia ratios and the initial state.
 
@@ -245,7 +260,10 @@ def fit(
         An extra start: ``inertia`` (3x3 or 3 moments), ``omega0``,
         ``attitude0`` (a quaternion); with it, only this start is used.
     max_iter : int
-        Levenberg–Marquardt iterations of the final stage.
+        Levenberg–Marquardt iterations of the final stage, 1 or more.
+    accept_poor_fit : bool
+        Return a poor fit (``result.poor_fit``, with ``result.convention_hint``)
+        instead of raising :class:`~eulerpoisson.errors.PoorFitError`.
 
     Returns
     -------
@@ -258,6 +276,11 @@ def fit(
         quaternions, a wrong frame...), an unknown ``principal_axes``, fewer
         residuals than unknowns, or no start that could be carried to an
         optimum.
+    PoorFitError
+        A poor fit (a :class:`FitInputError`): the reduced chi2 is above
+        :data:`POOR_FIT_CHI2` (100), or another reading of the same numbers
+        fits far better (see the module notes); the message names it, and
+        ``err.result`` holds the fit. Not with ``accept_poor_fit=True``.
     TypeError
         Non-numeric input.
 
@@ -271,16 +294,29 @@ def fit(
     >>> np.round(np.diag(res.inertia), 6)
     array([0.25, 0.33, 0.42])
 
+    Space-frame rates given as body rates: refused, naming the reading that fits.
+
+    >>> w_space = np.einsum("kab,kb->ka", tr.matrix, tr.omega)                # space-frame rates
+    >>> try:
+    ...     ep.fit(t, attitude=tr.quaternion, attitude_sigma=1e-3, omega=w_space, omega_sigma=1e-3)
+    ... except ep.estimation.PoorFitError as err:
+    ...     print(err)
+    poor fit: the angular velocities look space-frame: read so, the data fit far better (...); pass omega_frame='space' (command line: --omega-frame space); or pass accept_poor_fit=True to keep this fit
+
     References
     ----------
     D. W. Marquardt, J. SIAM 11 (1963) 431-441 (the search). Kaasalainen,
     A&A 376 (2001) 302 (spin states of tumbling asteroids).
     """
     if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)):
-        raise TypeError(f"max_iter must be a non-negative integer, got {type(max_iter).__name__} {max_iter!r}")
-    if max_iter < 0:
-        raise FitInputError(f"max_iter must be a non-negative integer, got {max_iter}")
+        raise TypeError(f"max_iter must be a positive integer (1 or more), got {type(max_iter).__name__} {max_iter!r}")
+    if max_iter < 1:
+        raise FitInputError(
+            f"max_iter must be a positive integer (1 or more Levenberg-Marquardt iterations), got {max_iter}"
+        )
     max_iter = int(max_iter)
+    if not isinstance(accept_poor_fit, (bool, np.bool_)):
+        raise TypeError(f"accept_poor_fit must be True or False, got {type(accept_poor_fit).__name__}")
     obs = observation_set(
         t,
         attitude=attitude,
@@ -348,9 +384,123 @@ def fit(
     found, n_equivalent = _prefer_slowest(found)
     best = found[0][1]
     final = evaluate(layout, obs, best.state)
-    return FitResult.from_search(
-        layout, obs, best, final, [f[0] for f in found], estimated, len(start_list), n_equivalent
+    dof = len(final.residuals) - layout.n_params
+    reduced = float(final.chi2 / dof) if dof > 0 else float("nan")
+    reading = None
+    if _suspect(obs, reduced, estimated):
+        reading = _better_reading(layout, obs, best.state, final)
+    hint = None if reading is None else reading_hint(reading[0], reduced, reading[1], detail=reading[2])
+    poor = bool(reduced > POOR_FIT_CHI2 or reading is not None)
+    res = FitResult.from_search(
+        layout,
+        obs,
+        best,
+        final,
+        [f[0] for f in found],
+        estimated,
+        len(start_list),
+        n_equivalent,
+        diagnosis={
+            "poor_fit": poor,
+            "convention_hint": hint,
+            "better_reading": None if reading is None else reading[0],
+            "_better_reading_fit": None if reading is None else reading[1:],
+        },
     )
+    if poor and not accept_poor_fit:
+        if hint:
+            why = hint
+        else:
+            why = f"reduced chi2 = {reduced:.4g} > {POOR_FIT_CHI2:g}: check the data's conventions and sigmas"
+        raise PoorFitError(f"poor fit: {why}; or pass accept_poor_fit=True to keep this fit", res)
+    return res
+
+
+#: the other readings of the data are tried when the reduced chi2 exceeds this...
+TRY_READINGS_CHI2 = 10.0
+#: ... or an estimated sigma is large: an angle's above this (radians, about 1 degree), a rate's above this
+#: fraction of the median observed rate (a wrong reading leaves residuals of the size of the signal)
+LARGE_ANGLE_SIGMA = 0.02
+LARGE_RATE_SIGMA = 0.02
+#: another reading fits far better when its chi2, with the same sigmas, is below this fraction of the fit's
+#: (residuals ten times smaller)
+FAR_BETTER = 0.01
+#: Levenberg-Marquardt iterations of the short fit of another reading
+READING_ITER = 30
+
+
+def _suspect(obs, reduced, estimated) -> bool:
+    """Whether the fit is poor enough to try the other readings of the data."""
+    if reduced > TRY_READINGS_CHI2:
+        return True
+    scale = {"attitude": obs.att_sigma, "axis": obs.ax_sigma, "omega": obs.om_sigma}
+    for kind in estimated:
+        sig = float(np.median(scale[kind]))
+        if kind == "omega":
+            ref = float(np.median(np.linalg.norm(obs.om_value, axis=1)))
+            if ref > 0 and sig > LARGE_RATE_SIGMA * ref:
+                return True
+        elif sig > LARGE_ANGLE_SIGMA:
+            return True
+    return False
+
+
+def _kind_chi2(obs, residuals) -> dict:
+    """The chi2 of each kind of observation (the whitened residuals are attitude, omega, axis in this order)."""
+    out, start = {}, 0
+    for kind, n in (("attitude", 3 * len(obs.att_idx)), ("omega", 3 * len(obs.om_idx)), ("axis", 2 * len(obs.ax_idx))):
+        if n:
+            r = residuals[start : start + n]
+            out[kind] = float(r @ r)
+            start += n
+    return out
+
+
+#: the kinds of observation as the hints name them
+KIND_NAMES = {"attitude": "attitude", "omega": "angular-velocity", "axis": "axis-direction"}
+
+
+def _better_reading(layout, obs, state, final):
+    """The reading of the data that fits far better than ``final``: (reading, reduced chi2, detail) or None.
+
+    Each reading gets one start (the inertia from the data, the rate and attitude guessed from them, else
+    the fit's) and a short search; the sigmas are those of the fit, so that the chi2 compare. Far better:
+    the chi2 falls below :data:`FAR_BETTER` of the fit's, in all or in one kind of observation while no
+    other kind gets more than twice worse (a sigma estimated from a wrong reading can hide one kind).
+    """
+    from .starts import attitude_guesses, inertia_from_data, omega_guess
+
+    before = _kind_chi2(obs, final.residuals)
+    best = None
+    for reading in obs.readings():
+        other = obs.reread(reading)
+        lay = Layout(other.attitude_observed, layout.inertia_mode, layout.fixed_inertia)
+        if lay.inertia_mode == "fixed":
+            I, p = layout.fixed_inertia, np.zeros(0)
+        else:
+            I = inertia_from_data(other, lay.inertia_mode)
+            if I is None:
+                I = inertia_matrix(layout, state.inertia_params)[0]
+            p = params_of(lay.inertia_mode, I)
+        w = omega_guess(other, other.att_q[0] if len(other.att_idx) else None)
+        if w is None:
+            w = state.omega0
+        first = [FitState(q, np.array(w, dtype=float), p) for q in attitude_guesses(other, lay, I, w)]
+        outs = _race(lay, other, first, _windows(other, lay.n_params), READING_ITER)
+        outs = [o for o in outs if np.isfinite(o.evaluation.chi2)]
+        if not outs:
+            continue
+        out = min(outs, key=lambda o: o.evaluation.chi2)
+        after = _kind_chi2(other, out.evaluation.residuals)
+        gain = {k: before[k] / max(after[k], 1e-300) for k in before}
+        total = sum(before.values()) / max(out.evaluation.chi2, 1e-300)
+        kind = max(gain, key=lambda k: gain[k])
+        far = total > 1.0 / FAR_BETTER or (gain[kind] > 1.0 / FAR_BETTER and min(gain.values()) > 0.5)
+        if far and (best is None or total > best[0]):
+            dof = len(out.evaluation.residuals) - lay.n_params
+            detail = f"{KIND_NAMES[kind]} residuals {np.sqrt(gain[kind]):.3g} times smaller"
+            best = (total, reading, out.evaluation.chi2 / dof if dof > 0 else float("nan"), detail)
+    return None if best is None else best[1:]
 
 
 def _prefer_slowest(found):

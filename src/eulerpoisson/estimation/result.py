@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..attitude.core import Attitude
 from ..numerics.quaternion import CONJUGATE, qmul
+from .data import POOR_FIT_CHI2, reading_hint
 from .residuals import inertia_matrix, log_quaternion
 
 if TYPE_CHECKING:
@@ -143,6 +144,17 @@ class FitResult:
         names the kinds whose sigma was estimated from the residuals.
     local_optima : tuple of LocalOptimum
         Distinct optima found by the search, best first.
+    poor_fit : bool
+        The reduced chi2 is absurd (above
+        :data:`~eulerpoisson.estimation.estimate.POOR_FIT_CHI2`, 100) or
+        another reading of the data fits far better (``fit`` returns such a
+        result only with ``accept_poor_fit=True``).
+    convention_hint : str or None
+        One line when another reading of the same numbers fits far better
+        (scalar-last quaternions, their conjugates, the rates in the other
+        frame or in degrees), naming what to do and the command-line flag.
+    better_reading : str or None
+        That reading: ``"xyzw"``, ``"conjugate"``, ``"space"``, ``"body"`` or ``"deg"``.
 
     Examples
     --------
@@ -180,6 +192,10 @@ class FitResult:
     converged: bool
     n_starts: int
     n_equivalent: int
+    poor_fit: bool
+    convention_hint: str | None
+    better_reading: str | None
+    _better_reading_fit: tuple[float, str] | None
     principal_axes_mode: str
     observations: ObservationSet
     _model_q: NDArray[np.float64]
@@ -197,7 +213,7 @@ class FitResult:
         raise AttributeError("FitResult is read-only")
 
     @classmethod
-    def from_search(cls, layout, obs, best, final, optima, estimated, n_starts, n_equivalent=1):
+    def from_search(cls, layout, obs, best, final, optima, estimated, n_starts, n_equivalent=1, diagnosis=None):
         """The result of ``fit``'s search: the best optimum, its covariance and the other optima found.
 
         Made by ``fit`` from its internal state (the parameter layout, the observations, the optima of
@@ -275,6 +291,10 @@ class FitResult:
             principal_axes_mode=layout.inertia_mode,
             observations=obs,
             n_equivalent=int(n_equivalent),
+            poor_fit=bool((diagnosis or {}).get("poor_fit", False)),
+            convention_hint=(diagnosis or {}).get("convention_hint"),
+            better_reading=(diagnosis or {}).get("better_reading"),
+            _better_reading_fit=(diagnosis or {}).get("_better_reading_fit"),
             _model_q=final.quaternion,
             _model_omega=final.omega,
             _model_rows=final.rows,
@@ -318,8 +338,52 @@ class FitResult:
         return out[0] if scalar else out
 
     # ------------------------------------------------------------------
-    def as_dict(self) -> dict[str, Any]:
-        """Everything as plain Python (what :meth:`to_json` writes); NaN (undetermined) becomes None."""
+    def sigma_in(self, *, angle_unit: str = "rad", rate_unit: str = "rad") -> tuple[dict, dict]:
+        """The standard deviations (:attr:`sigma`) in the given units, and the units: ``(values, units)``.
+
+        Parameters
+        ----------
+        angle_unit : {"rad", "deg"}
+            Of the attitude and axis sigmas.
+        rate_unit : {"rad", "deg"}
+            Of the angular-velocity sigma: radians or degrees per unit of ``t``.
+
+        Raises
+        ------
+        ValueError
+            Another unit.
+
+        Examples
+        --------
+        >>> import numpy as np, eulerpoisson as ep
+        >>> t = np.linspace(0.0, 10.0, 41)
+        >>> truth = ep.solve([0.25, 0.33, 0.42], t, omega0=[0.1, 0.2, 1.0])
+        >>> res = ep.fit(t, attitude=truth.quaternion, attitude_sigma=np.radians(0.5), omega=truth.omega,
+        ...              omega_sigma=1e-3)
+        >>> values, units = res.sigma_in(angle_unit="deg")
+        >>> print(round(values["attitude"], 9), units["attitude"], values["omega"], units["omega"])
+        0.5 deg 0.001 rad per unit of t
+        """
+        factor = {}
+        for name, unit in (("angle_unit", angle_unit), ("rate_unit", rate_unit)):
+            if unit not in ("rad", "deg"):
+                raise ValueError(f"{name} must be 'rad' or 'deg', got {unit!r}")
+            factor[name] = 1.0 if unit == "rad" else 180.0 / np.pi
+        values, units = {}, {}
+        for k, v in self.sigma.items():
+            if k == "omega":
+                values[k], units[k] = float(v) * factor["rate_unit"], f"{rate_unit} per unit of t"
+            else:
+                values[k], units[k] = float(v) * factor["angle_unit"], angle_unit
+        return values, units
+
+    def as_dict(self, *, angle_unit: str = "rad", rate_unit: str = "rad") -> dict[str, Any]:
+        """Everything as plain Python (what :meth:`to_json` writes); NaN (undetermined) becomes None.
+
+        ``sigma`` is in ``angle_unit`` (attitude, axis) and ``rate_unit`` (per unit of ``t``), as
+        ``sigma_units`` says next to it (:meth:`sigma_in`); everything else in radians.
+        """
+        sigma, sigma_units = self.sigma_in(angle_unit=angle_unit, rate_unit=rate_unit)
         d = {
             "epoch": self.epoch,
             "inertia": self.inertia.tolist(),
@@ -335,9 +399,12 @@ class FitResult:
             "chi2": self.chi2,
             "dof": self.dof,
             "reduced_chi2": self.reduced_chi2,
-            "sigma": dict(self.sigma),
+            "sigma": sigma,
+            "sigma_units": sigma_units,
             "sigma_estimated": list(self.sigma_estimated),
             "converged": self.converged,
+            "poor_fit": self.poor_fit,
+            "convention_hint": self.convention_hint,
             "principal_axes_mode": self.principal_axes_mode,
             "n_observations": {k: int(len(v)) for k, v in self.residuals.items() if not k.endswith("_t")},
             "local_optima": [o.as_dict() for o in self.local_optima],
@@ -349,17 +416,30 @@ class FitResult:
         }
         return _finite_or_none(d)
 
-    def to_json(self, path: str | os.PathLike[str] | None = None, *, indent: int = 2) -> str:
-        """The result as JSON text; written atomically to ``path`` when given."""
-        text = json.dumps(self.as_dict(), indent=indent, allow_nan=False) + "\n"
+    def to_json(
+        self,
+        path: str | os.PathLike[str] | None = None,
+        *,
+        indent: int = 2,
+        angle_unit: str = "rad",
+        rate_unit: str = "rad",
+    ) -> str:
+        """The result as JSON text (:meth:`as_dict`, the sigmas in these units); written atomically to ``path``."""
+        text = json.dumps(self.as_dict(angle_unit=angle_unit, rate_unit=rate_unit), indent=indent, allow_nan=False)
+        text += "\n"
         if path is not None:
             from ..io.atomic import atomic_write_text
 
             atomic_write_text(path, text)
         return text
 
-    def summary(self) -> str:
-        """A readable table: the body, the state, their standard errors, and the fit's quality."""
+    def summary(self, *, angle_unit: str = "rad", rate_unit: str = "rad", flag: str | None = None) -> str:
+        """A readable table: the body, the state, their standard errors, and the fit's quality.
+
+        The sigmas are shown in ``angle_unit`` and ``rate_unit`` (:meth:`sigma_in`), with their units;
+        ``flag``: the command-line flag that gives the better reading, named instead of the API's advice.
+        """
+        sigma, sigma_units = self.sigma_in(angle_unit=angle_unit, rate_unit=rate_unit)
         lines = []
         kinds = ", ".join(f"{k} {len(v)}" for k, v in self.residuals.items() if not k.endswith("_t"))
         lines.append(f"fit of a torque-free body: observations {kinds}; epoch t0 = {self.epoch:g}")
@@ -370,8 +450,21 @@ class FitResult:
         if self.sigma_estimated:
             lines.append(
                 "  sigma estimated from the residuals: "
-                + ", ".join(f"{k} {self.sigma[k]:.3g}" for k in self.sigma_estimated)
+                + ", ".join(f"{k} {sigma[k]:.3g} {sigma_units[k]}" for k in self.sigma_estimated)
             )
+        given = [k for k in sigma if k not in self.sigma_estimated]
+        if given:
+            lines.append("  sigma given: " + ", ".join(f"{k} {sigma[k]:.3g} {sigma_units[k]}" for k in given))
+        if self.poor_fit:
+            why = (
+                f"reduced chi2 = {self.reduced_chi2:.4g} > {POOR_FIT_CHI2:g}"
+                if self.reduced_chi2 > POOR_FIT_CHI2
+                else "another reading of the data fits far better"
+            )
+            lines.append(f"  POOR FIT: {why}: the numbers below do not describe the data")
+        if self.convention_hint:
+            advice = self.reading_advice(flag) if flag is not None else None
+            lines.append("  " + (advice or self.convention_hint))
         lines.append(f"  {'parameter':<14}{'value':>16}{'stderr':>14}")
         for n in list(self.parameter_names) + [k for k in ("I_zz", "I_1", "I_2", "I_3") if k in self.parameters]:
             lines.append(f"  {n:<14}{self.parameters[n]:>16.9g}{self.stderr[n]:>14.3g}")
@@ -409,6 +502,13 @@ class FitResult:
         else:
             lines.append(f"  one optimum from {self.n_starts} starts")
         return "\n".join(lines)
+
+    def reading_advice(self, flag: str) -> str | None:
+        """:attr:`convention_hint` naming only the command-line ``flag`` that reads the data so; None without one."""
+        if self.better_reading is None or self._better_reading_fit is None:
+            return None
+        better, detail = self._better_reading_fit
+        return reading_hint(self.better_reading, self.reduced_chi2, better, detail=detail, flag=flag)
 
     def __repr__(self) -> str:
         return f"<FitResult chi2={self.chi2:.4g} dof={self.dof} moments={np.round(self.principal_moments, 6).tolist()}>"

@@ -7,7 +7,13 @@ full disk) never leaves a half-written file under the final name.
 Errors name the file the caller asked for, never the temporary file: a
 failure to write raises :class:`OSError` (the subclass and ``errno`` of the
 original error, e.g. :class:`FileNotFoundError`) with the message
-``cannot write PATH: REASON``.
+``cannot write PATH: REASON; WHAT TO DO`` (the advice for a full disk, a
+read-only file system or a folder without write permission).
+
+A command that claims an output (:func:`eulerpoisson.io.outputs.claim_output`)
+registers a check with :func:`guard_replace`: every atomic write to that path
+runs it just before the rename, so that an output that appeared meanwhile is
+not replaced.
 """
 
 from __future__ import annotations
@@ -18,9 +24,23 @@ import glob
 import os
 import stat
 import tempfile
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from ..errors import InvalidInputError
+
+#: what to do about a failed write, by errno
+WRITE_ADVICE = {
+    _errno.ENOSPC: "free some space on that disk or write to another one",
+    _errno.EDQUOT: "free some space within your disk quota or write to another disk",
+    _errno.EROFS: "its file system is read-only: write to a folder on a writable disk",
+    _errno.EACCES: "you may not write in that folder: write to another folder or change its permissions",
+    _errno.EPERM: "you may not write there: write to another folder or change its permissions",
+    _errno.EMFILE: "too many open files: close other programs or raise the limit (ulimit -n)",
+}
+
+#: checks run just before an atomic rename to a path (absolute path -> check), see :func:`guard_replace`
+_GUARDS: dict[str, Callable[[], None]] = {}
 
 
 def _target(path) -> Path:
@@ -37,8 +57,18 @@ def _target(path) -> Path:
 
 
 def write_error(dest, exc: OSError) -> OSError:
-    """``exc`` re-worded to name ``dest`` (the caller's file), keeping its errno and class."""
+    """``exc`` re-worded to name ``dest`` (the caller's file) and say what to do, keeping its errno and class.
+
+    Examples
+    --------
+    >>> import errno
+    >>> str(write_error("out/r.nc", OSError(errno.EROFS, "Read-only file system", "out/.r.nc.x.tmp")))
+    '[Errno 30] cannot write out/r.nc: Read-only file system; its file system is read-only: write to a folder on a writable disk'
+    """
     reason = exc.strerror or str(exc) or type(exc).__name__
+    advice = WRITE_ADVICE.get(exc.errno) if exc.errno is not None else None
+    if advice and advice not in reason:
+        reason = f"{reason}; {advice}"
     if exc.errno is None:
         return OSError(f"cannot write {dest}: {reason}")
     return OSError(exc.errno, f"cannot write {dest}: {reason}")  # OSError(errno, ...) picks the subclass
@@ -46,6 +76,50 @@ def write_error(dest, exc: OSError) -> OSError:
 
 def _names_tmp(exc: OSError, tmp: str) -> bool:
     return tmp in (exc.filename, exc.filename2) or os.path.basename(tmp) in str(exc)
+
+
+@contextlib.contextmanager
+def guard_replace(path, check: Callable[[], None]) -> Iterator[None]:
+    """Run ``check()`` just before every atomic rename to ``path`` made meanwhile (in this process).
+
+    ``check`` raises to stop the rename: the temporary file is removed and
+    ``path`` is left as it is.
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> d = tempfile.mkdtemp()
+    >>> def refuse():
+    ...     raise FileExistsError("no")
+    >>> with guard_replace(os.path.join(d, "a.txt"), refuse):
+    ...     atomic_write_text(os.path.join(d, "a.txt"), "x")
+    Traceback (most recent call last):
+    ...
+    FileExistsError: no
+    >>> os.listdir(d)
+    []
+    """
+    key = os.path.abspath(os.fspath(path))
+    previous = _GUARDS.get(key)
+    _GUARDS[key] = check
+    try:
+        yield
+    finally:
+        if previous is None:
+            _GUARDS.pop(key, None)
+        else:
+            _GUARDS[key] = previous
+
+
+def check_guard(path) -> None:
+    """Run the check registered for ``path`` with :func:`guard_replace` (nothing when there is none).
+
+    For writers that move a whole folder into place rather than a file
+    (:func:`atomic_path` calls it itself).
+    """
+    check = _GUARDS.get(os.path.abspath(os.fspath(path)))
+    if check is not None:
+        check()
 
 
 @contextlib.contextmanager
@@ -86,6 +160,7 @@ def atomic_path(path, suffix: str | None = None):
             if _names_tmp(exc, tmp):
                 raise write_error(dest, exc) from exc
             raise
+        check_guard(dest)  # the output's claim: checked again just before the rename
         try:
             if dest.is_file():  # a replaced file keeps its permissions
                 os.chmod(tmp, stat.S_IMODE(os.stat(dest).st_mode))

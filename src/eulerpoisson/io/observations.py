@@ -17,7 +17,10 @@ Conventions: quaternions are scalar first ``(w, x, y, z)`` with
 ``x_space = R x_body``; :math:`\boldsymbol\Omega` is the body angular
 velocity and :math:`\boldsymbol\omega = R\boldsymbol\Omega` the space one;
 angles are in radians except where a name ends in ``_deg``; rates are in
-radians per unit of ``t``.
+radians per unit of ``t`` (degrees with ``omega_unit="deg"``, their sigmas
+too). Files written in other conventions are read with ``quaternion_order``,
+``attitude_convention`` and ``omega_unit`` (``fit`` names the one to use when
+another reading of the numbers fits far better).
 
 CSV columns
 -----------
@@ -95,6 +98,9 @@ TOML settings
     omega_frame = "body"        # "body" or "space"
     axis = [0, 0, 1]            # the body axis of ax, ay, az
     principal_axes = "given"    # "given" or "fit"
+    quaternion_order = "wxyz"   # the quaternion columns in file order: "wxyz" or "xyzw" (scalar last)
+    attitude_convention = "body-to-space"  # or "space-to-body" (the conjugate quaternions)
+    omega_unit = "rad"          # "rad" or "deg": wx, wy, wz and their sigmas per unit of t
 
 Other top-level tables are left to their readers; an unknown key in
 ``[observations]`` is an error.
@@ -110,6 +116,7 @@ frame of ``omega`` it is ``"body"``.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 import numbers
 import os
@@ -124,7 +131,15 @@ from numpy.typing import ArrayLike
 from ..attitude.core import UNIT_QUATERNION_TOLERANCE
 from ..errors import InvalidInputError, require
 
-__all__ = ["Observations", "read_observations", "CSV_COLUMNS", "UNIT_TOLERANCE"]
+__all__ = [
+    "Observations",
+    "read_observations",
+    "CSV_COLUMNS",
+    "UNIT_TOLERANCE",
+    "QUATERNION_ORDERS",
+    "ATTITUDE_CONVENTIONS",
+    "OMEGA_UNITS",
+]
 
 #: largest relative deviation of the norm of a quaternion or a direction from 1 that is accepted (and removed)
 UNIT_TOLERANCE = UNIT_QUATERNION_TOLERANCE  # 1e-6, as for every unit quaternion the package accepts
@@ -150,7 +165,22 @@ _FIXED_COLS = frozenset(c for c in CSV_COLUMNS if "SEQ" not in c)
 
 _FRAMES = ("body", "space")
 _PRINCIPAL = ("given", "fit")
-_TOML_KEYS = ("file", "sigma_attitude_deg", "sigma_omega", "sigma_axis_deg", "omega_frame", "axis", "principal_axes")
+_TOML_KEYS = (
+    "file",
+    "sigma_attitude_deg",
+    "sigma_omega",
+    "sigma_axis_deg",
+    "omega_frame",
+    "axis",
+    "principal_axes",
+    "quaternion_order",
+    "attitude_convention",
+    "omega_unit",
+)
+#: the readings of the numbers (what ``fit`` suggests when another one fits far better)
+QUATERNION_ORDERS = ("wxyz", "xyzw")
+ATTITUDE_CONVENTIONS = ("body-to-space", "space-to-body")
+OMEGA_UNITS = ("rad", "deg")
 
 _NC_ATTITUDE = ("q", "attitude")
 _NC_ATTITUDE_SIGMA = ("attitude_sigma", "q_sigma")
@@ -201,6 +231,9 @@ class Observations:
     ignored : tuple of str
         Columns (CSV) or variables (NetCDF) of the file that are not
         observations and were not read, e.g. a second clock.
+    files : tuple of str
+        Every file read: ``source`` and, for a TOML file, the data file it
+        names (inputs, never to be overwritten by an output).
     """
 
     t: np.ndarray
@@ -215,6 +248,7 @@ class Observations:
     principal_axes: str | None = None
     source: str = ""
     ignored: tuple[str, ...] = ()
+    files: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.t.shape[0])
@@ -288,6 +322,14 @@ def _frame(value, name: str) -> str:
     return value
 
 
+def _choice(value, name: str, allowed: tuple) -> str:
+    if isinstance(value, np.str_):
+        value = str(value)
+    if not isinstance(value, str) or value not in allowed:
+        raise InvalidInputError(f"{name} must be one of {', '.join(repr(a) for a in allowed)}, got {value!r}")
+    return value
+
+
 def _principal(value, name: str) -> str:
     if isinstance(value, np.str_):
         value = str(value)
@@ -325,6 +367,9 @@ class _Settings:
     omega_frame: str | None = None
     axis: np.ndarray | None = None
     principal_axes: str | None = None
+    quaternion_order: str | None = None
+    attitude_convention: str | None = None
+    omega_unit: str | None = None
     # where each came from, for messages ("omega_frame=" or "obs.toml: [observations] omega_frame")
     origin: dict = dataclass_field(default_factory=dict)
 
@@ -339,7 +384,7 @@ def _read_toml(p: Path, shown: str) -> tuple[Path, _Settings]:
         raise InvalidInputError(f"{shown}: invalid TOML: {exc}") from None
     except UnicodeDecodeError as exc:
         raise InvalidInputError(
-            f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); a TOML file must be UTF-8"
+            f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); a TOML file must be UTF-8: save it as UTF-8"
         ) from None
     except RecursionError:
         raise InvalidInputError(f"{shown}: invalid TOML: nested too deeply") from None
@@ -385,6 +430,14 @@ def _read_toml(p: Path, shown: str) -> tuple[Path, _Settings]:
     if "principal_axes" in obs:
         s.principal_axes = _principal(obs["principal_axes"], where + "principal_axes")
         s.origin["principal_axes"] = where + "principal_axes"
+    for key, allowed in (
+        ("quaternion_order", QUATERNION_ORDERS),
+        ("attitude_convention", ATTITUDE_CONVENTIONS),
+        ("omega_unit", OMEGA_UNITS),
+    ):
+        if key in obs:
+            setattr(s, key, _choice(obs[key], where + key, allowed))
+            s.origin[key] = where + key
     return data, s
 
 
@@ -417,6 +470,7 @@ class _Raw:
     omega_sigma: _Block | None = None
     axis_sigma: _Block | None = None
     omega_frame: str | None = None  # stated by the file
+    q_file_order: tuple = (0, 1, 2, 3)  # the columns of ``attitude`` in the order of the file
     axis: np.ndarray | None = None
     principal_axes: str | None = None
     ignored: tuple = ()
@@ -436,7 +490,8 @@ def _read_csv(p: Path, shown: str) -> _Raw:
             text = fh.read()
     except UnicodeDecodeError as exc:
         raise InvalidInputError(
-            f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); a CSV observations file must be UTF-8"
+            f"{shown}: not UTF-8 text ({exc.reason} at byte {exc.start}); a CSV observations file must be UTF-8: "
+            f"save it as UTF-8 (e.g. iconv -f latin1 -t utf-8 {shown} > {Path(shown).stem}-utf8.csv)"
         ) from None
     except OSError as exc:
         raise InvalidInputError(f"{shown}: cannot read the file: {exc.strerror or exc}") from None
@@ -579,6 +634,7 @@ def _read_csv(p: Path, shown: str) -> _Raw:
     )
     if has_q:
         raw.attitude = block(_Q_COLS, "columns qw, qx, qy, qz")
+        raw.q_file_order = tuple(sorted(range(4), key=lambda k: index[_Q_COLS[k]]))
     if seq is not None:
         cols = tuple(f"euler_{seq}_{k}" for k in (1, 2, 3))
         raw.euler_seq = seq
@@ -840,9 +896,24 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
     origin = s.origin or {}
     t = _check_times(raw)
 
+    def said(key, value):
+        """How ``key`` was set: ``omega_frame='space'`` or ``obs.toml: [observations] omega_frame = 'space'``."""
+        return f"{origin[key]} = {value}" if key in origin else f"{key}={value}"
+
     attitude = None
     att_given = None
+    if s.quaternion_order is not None and raw.attitude is None:
+        raise InvalidInputError(
+            f"{said('quaternion_order', repr(s.quaternion_order))} is given, but {raw.file} has no quaternions"
+        )
     if raw.attitude is not None:
+        if s.quaternion_order is not None:
+            assert isinstance(raw.attitude.values, np.ndarray)  # (N, 4)
+            order = list(raw.q_file_order)
+            if s.quaternion_order == "xyzw":
+                order = [order[k] for k in (3, 0, 1, 2)]
+            raw.attitude.values = raw.attitude.values[:, order]
+            raw.attitude.labels = tuple(raw.attitude.labels[k] for k in order)
         attitude = _unit_rows(raw, raw.attitude, "the quaternion", "unit quaternion")
         att_given = np.isfinite(attitude[:, 0])
     elif raw.euler is not None:
@@ -854,21 +925,29 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
             assert raw.euler_seq is not None and isinstance(raw.euler.values, np.ndarray)  # read with the angles
             attitude[att_given] = quaternion_from_euler(raw.euler_seq, raw.euler.values[att_given], degrees=True)
 
+    if s.attitude_convention is not None and attitude is None:
+        raise InvalidInputError(
+            f"{said('attitude_convention', repr(s.attitude_convention))} is given, but {raw.file} has no attitude"
+        )
+    if attitude is not None and s.attitude_convention == "space-to-body":
+        attitude = attitude * np.array([1.0, -1.0, -1.0, -1.0])
+
     omega = None
     om_given = None
     if raw.omega is not None:
         om_given = _whole_rows(raw, raw.omega, "the angular velocity")
         omega = raw.omega.values
+    if s.omega_unit is not None and omega is None:
+        raise InvalidInputError(f"{said('omega_unit', repr(s.omega_unit))} is given, but {raw.file} has no rates")
+    rate = math.pi / 180.0 if s.omega_unit == "deg" else 1.0  # to radians per unit of t
+    if omega is not None and rate != 1.0:
+        omega = omega * rate
 
     axis_direction = None
     if raw.axis_direction is not None:
         axis_direction = _unit_rows(raw, raw.axis_direction, "the axis direction", "direction")
 
     # settings against the file
-    def said(key, value):
-        """How ``key`` was set: ``omega_frame='space'`` or ``obs.toml: [observations] omega_frame = 'space'``."""
-        return f"{origin[key]} = {value}" if key in origin else f"{key}={value}"
-
     for key, has in (
         ("sigma_attitude_deg", attitude is not None),
         ("sigma_omega", omega is not None),
@@ -929,10 +1008,10 @@ def _assemble(raw: _Raw, s: _Settings, source: str) -> Observations:
             attitude_sigma = _sigma(raw, raw.attitude_sigma, att_given)
     if omega is not None:
         if s.sigma_omega is not None:
-            omega_sigma = s.sigma_omega
+            omega_sigma = s.sigma_omega * rate
         elif raw.omega_sigma is not None:
             assert om_given is not None  # set with omega
-            omega_sigma = _sigma(raw, raw.omega_sigma, om_given)
+            omega_sigma = _sigma(raw, raw.omega_sigma, om_given) * rate
     if axis_direction is not None:
         if s.sigma_axis_deg is not None:
             axis_sigma = s.sigma_axis_deg * deg
@@ -966,6 +1045,9 @@ def read_observations(
     sigma_axis_deg: float | None = None,
     omega_frame: str | None = None,
     axis: ArrayLike | None = None,
+    quaternion_order: str | None = None,
+    attitude_convention: str | None = None,
+    omega_unit: str | None = None,
 ) -> Observations:
     """Read an observations file (``.csv``, ``.nc`` or ``.toml``; see the module notes for the columns).
 
@@ -978,8 +1060,9 @@ def read_observations(
         ``sigma_attitude_deg`` column (or ``attitude_sigma`` variable) and the
         TOML setting.
     sigma_omega : float, optional, keyword-only
-        Standard deviation of every angular-velocity component, radians per
-        unit of ``t``; replaces the file's sigma and the TOML setting.
+        Standard deviation of every angular-velocity component, in the unit
+        of the rates (``omega_unit``: radians per unit of ``t`` by default);
+        replaces the file's sigma and the TOML setting.
     sigma_axis_deg : float, optional, keyword-only
         Standard deviation of every axis direction, degrees; replaces the
         file's sigma and the TOML setting.
@@ -990,6 +1073,17 @@ def read_observations(
         The body axis whose space direction ``ax, ay, az`` gives; normalized.
         Required with those columns unless the TOML file or the NetCDF
         attribute ``axis`` gives it.
+    quaternion_order : {"wxyz", "xyzw"}, optional, keyword-only
+        What the four quaternion columns hold, in the order they appear in
+        the file (NetCDF: the four components): scalar first or scalar last
+        (x, y, z, w). Default: as the column names say (NetCDF: scalar first).
+    attitude_convention : {"body-to-space", "space-to-body"}, optional, keyword-only
+        What the attitudes rotate; ``"space-to-body"``: they are conjugated.
+        Default ``"body-to-space"`` (``x_space = R x_body``).
+    omega_unit : {"rad", "deg"}, optional, keyword-only
+        Unit of ``wx, wy, wz`` and of their sigmas (``sigma_omega``, the file's
+        sigma): radians (default) or degrees per unit of ``t``; degrees are
+        converted to radians.
 
     Returns
     -------
@@ -1046,6 +1140,13 @@ def read_observations(
         s.omega_frame = _frame(omega_frame, "omega_frame")
     if axis is not None:
         s.axis = _unit_axis(axis, "axis")
+    for key, value, allowed in (
+        ("quaternion_order", quaternion_order, QUATERNION_ORDERS),
+        ("attitude_convention", attitude_convention, ATTITUDE_CONVENTIONS),
+        ("omega_unit", omega_unit, OMEGA_UNITS),
+    ):
+        if value is not None:
+            setattr(s, key, _choice(value, key, allowed))
 
     p = Path(shown)
     ext = p.suffix.lower()
@@ -1060,13 +1161,23 @@ def read_observations(
         data_shown = str(data)
         _check_file(data, f"{data_shown} (the file of {shown})")
         # keyword arguments override the TOML settings
-        for key in ("sigma_attitude_deg", "sigma_omega", "sigma_axis_deg", "omega_frame", "axis"):
+        for key in (
+            "sigma_attitude_deg",
+            "sigma_omega",
+            "sigma_axis_deg",
+            "omega_frame",
+            "axis",
+            "quaternion_order",
+            "attitude_convention",
+            "omega_unit",
+        ):
             if getattr(s, key) is not None:
                 t_set.origin.pop(key, None)
                 setattr(t_set, key, getattr(s, key))
         s = t_set
     raw = _read_csv(data, data_shown) if data.suffix.lower() == ".csv" else _read_netcdf(data, data_shown)
-    return _assemble(raw, s, shown)
+    files = (str(p),) if data == p else (str(p), str(data))
+    return dataclasses.replace(_assemble(raw, s, shown), files=files)
 
 
 def _check_file(p: Path, shown: str) -> None:

@@ -26,7 +26,8 @@ class CallableTorque(Torque):
     The function receives the time (a float, or an array broadcast against the
     batch), the attitude quaternions ``q`` (..., 4) (scalar first) and the body
     angular velocities (..., 3), and must return the body-frame torque with the
-    shape of ``omega``, vectorized over the batch. Only methods that evaluate a
+    shape of ``omega`` (real numbers; one vector (3,) is taken for every body
+    of a batch), vectorized over the batch. Only methods that evaluate a
     right-hand side can run it (``rk``).
 
     Parameters
@@ -38,7 +39,10 @@ class CallableTorque(Torque):
     Raises
     ------
     TypeError
-        ``func`` is not callable.
+        ``func`` is not callable (here), or returns something that is not numbers (at ``evaluate``).
+    InvalidInputError
+        At ``evaluate``: the function returned a scalar or a shape that is not ``(..., 3)``
+        broadcastable to the shape of ``omega``, complex or boolean values, or NaN or infinite values.
 
     Examples
     --------
@@ -50,6 +54,11 @@ class CallableTorque(Torque):
     (CallableTorque('damping'), 'callable')
     >>> print(tq.evaluate(0.0, np.eye(3), np.array([1.0, 2.0, 3.0]), np.eye(3)))
     [-0.1 -0.2 -0.3]
+    >>> try:
+    ...     ep.torques.CallableTorque(lambda t, q, omega: 0.1).evaluate(0.0, np.eye(3), np.ones(3), np.eye(3))
+    ... except ep.InvalidInputError as err:
+    ...     print(err)
+    the torque function CallableTorque('<lambda>') returned shape (); expected (3,) (the shape of omega: ...
     """
 
     kind = "callable"
@@ -75,16 +84,33 @@ class CallableTorque(Torque):
 
             q = quaternion_from_rotation_matrix(R)
         tau = self.func(t, q, omega)
+        expected = np.shape(omega)
         try:
-            tau = np.asarray(tau, dtype=float)
+            raw = np.asarray(tau)
         except (TypeError, ValueError):
             raise TypeError(f"the torque function {self.func!r} must return a float array, got {tau!r}") from None
-        if tau.shape != np.shape(omega):
+        if np.iscomplexobj(raw) or raw.dtype == bool:
+            # a complex torque would lose its imaginary part, a boolean one would be 0 and 1: refuse both
+            raise InvalidInputError(
+                f"the torque function {self!r} returned {raw.dtype} values; expected real numbers (float64) "
+                f"of shape {expected} (one body-frame torque per body)"
+            )
+        try:
+            tau = raw.astype(float, copy=False)
+        except (TypeError, ValueError):
+            raise TypeError(f"the torque function {self.func!r} must return a float array, got {tau!r}") from None
+        if tau.ndim == 0 or tau.shape[-1] != 3:
+            # a scalar (or a list of one value) would silently become the same value on all three axes
+            raise InvalidInputError(
+                f"the torque function {self!r} returned shape {tau.shape}; expected {expected} (the shape of "
+                f"omega: one body-frame torque vector (3 components) per body)"
+            )
+        if tau.shape != expected:
             try:
-                tau = np.broadcast_to(tau, np.shape(omega))
+                tau = np.broadcast_to(tau, expected)  # one vector (3,) for every body of a batch
             except ValueError:
                 raise InvalidInputError(
-                    f"the torque function {self.func!r} returned shape {tau.shape}; expected {np.shape(omega)} "
+                    f"the torque function {self.func!r} returned shape {tau.shape}; expected {expected} "
                     f"(the shape of omega: one body-frame torque per body)"
                 ) from None
         if not np.all(np.isfinite(tau)):

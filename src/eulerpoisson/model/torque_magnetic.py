@@ -157,16 +157,25 @@ class MagneticDipoleTorque(Torque):
         Raises
         ------
         InvalidInputError
-            A callable field that returns an array not ending in 3, or NaN or infinite values.
+            A callable field that returns an array not ending in 3, complex or boolean values, or NaN or
+            infinite values.
         """
         if not callable(self.field):
             return self.field
-        B = self.field(t)
+        value = self.field(t)
         try:
-            B = np.asarray(B, dtype=float)
-        except (TypeError, ValueError):
+            B = np.asarray(value)
+            if np.iscomplexobj(B) or B.dtype == bool:  # the imaginary part would be dropped, True read as 1
+                raise InvalidInputError(
+                    f"the magnetic field function {self.field!r} returned {B.dtype} values; expected real numbers "
+                    "(float64) of shape (..., 3) (the field in the space frame)"
+                )
+            B = B.astype(float, copy=False)
+        except (TypeError, ValueError) as exc:
+            if isinstance(exc, InvalidInputError):
+                raise
             raise TypeError(
-                f"the magnetic field function {self.field!r} must return a float array, got {B!r}"
+                f"the magnetic field function {self.field!r} must return a float array, got {value!r}"
             ) from None
         if B.ndim == 0 or B.shape[-1] != 3:
             raise InvalidInputError(

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InvalidInputError
+from ..errors import EulerPoissonError, InvalidInputError
 from .runs import CSV_HEADER
 
 if TYPE_CHECKING:
@@ -336,6 +336,12 @@ def _readme(cases, netcdf: bool) -> str:
 def write_cases(out: str | os.PathLike[str], names: Sequence[str] | None = None, *, netcdf: bool = True) -> list[str]:
     """Write the suite into a folder: ``NAME.csv``, ``NAME.nc``, ``cases.json`` and ``README.md``.
 
+    The files are written into a hidden folder next to ``out`` and moved
+    into place at the end: a failure (a full disk, a missing dependency,
+    Ctrl-C) leaves ``out`` as it was (no new empty folder). Into a folder of
+    cases written before, the cases it lists that are not written again are
+    removed (the index always lists what is there); other files are kept.
+
     Parameters
     ----------
     out : str or os.PathLike
@@ -354,6 +360,8 @@ def write_cases(out: str | os.PathLike[str], names: Sequence[str] | None = None,
     ------
     InvalidInputError
         An unknown case name; ``out`` is an existing file.
+    OSError
+        A file cannot be written: the message names ``out`` and what to do.
 
     Examples
     --------
@@ -363,27 +371,71 @@ def write_cases(out: str | os.PathLike[str], names: Sequence[str] | None = None,
     >>> sorted(os.path.basename(f) for f in files)
     ['README.md', 'cases.json', 'sphere.csv']
     """
+    import shutil
+    import tempfile
+
+    from ..io.atomic import check_guard, write_error
+    from ..io.outputs import mark_text
+
     out = os.fspath(out)
     if os.path.exists(out) and not os.path.isdir(out):
         raise InvalidInputError(f"{out} is a file; give a folder for the reference cases")
     cases = reference_cases()
     chosen = list(cases.values()) if names is None else [reference_case(n) for n in names]
-    os.makedirs(out, exist_ok=True)
-    written = []
-    for c in chosen:
-        p = os.path.join(out, f"{c.name}.csv")
-        c.to_csv(p)
-        written.append(p)
-        if netcdf:
-            p = os.path.join(out, f"{c.name}.nc")
-            c.to_netcdf(p)
-            written.append(p)
-    p = os.path.join(out, "cases.json")
-    with open(p, "w", encoding="utf-8") as fh:
-        json.dump([c.to_dict() for c in chosen], fh, indent=1)
-    written.append(p)
-    p = os.path.join(out, "README.md")
-    with open(p, "w", encoding="utf-8") as fh:
-        fh.write(_readme(chosen, netcdf))
-    written.append(p)
-    return written
+    target = os.path.abspath(out)
+    try:
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        stage = tempfile.mkdtemp(prefix=f".{os.path.basename(target)}.", suffix=".partial", dir=os.path.dirname(target))
+    except OSError as exc:
+        raise write_error(out, exc) from exc
+    try:
+        try:
+            staged = []
+            for c in chosen:
+                c.to_csv(os.path.join(stage, f"{c.name}.csv"))
+                staged.append(f"{c.name}.csv")
+                if netcdf:
+                    c.to_netcdf(os.path.join(stage, f"{c.name}.nc"))
+                    staged.append(f"{c.name}.nc")
+            with open(os.path.join(stage, "cases.json"), "w", encoding="utf-8") as fh:
+                json.dump([c.to_dict() for c in chosen], fh, indent=1)
+            staged.append("cases.json")
+            with open(os.path.join(stage, "README.md"), "w", encoding="utf-8") as fh:
+                fh.write(mark_text(_readme(chosen, netcdf), "reference-cases", "md"))
+            staged.append("README.md")
+            check_guard(out)  # the output's claim (eulerpoisson cases): checked again before the move
+            _publish(stage, target, staged)
+        except EulerPoissonError:
+            raise  # the claim's refusal (OutputError), a missing dependency: as they are
+        except OSError as exc:
+            cause: BaseException = exc  # the first error (a file written inside the hidden folder names it)
+            while isinstance(cause.__cause__, OSError):
+                cause = cause.__cause__
+            raise write_error(out, cause if isinstance(cause, OSError) else exc) from exc
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+    return [os.path.join(out, f) for f in staged]
+
+
+def _publish(stage: str, target: str, staged: list[str]) -> None:
+    """Move the files written in ``stage`` into ``target``; remove the cases ``target`` listed and lost."""
+    if not os.path.isdir(target):
+        os.replace(stage, target)  # a new folder, all at once
+        return
+    stale: set[str] = set()
+    try:
+        with open(os.path.join(target, "cases.json"), encoding="utf-8") as fh:
+            old = json.load(fh)
+        stale = {
+            f"{c['name']}{ext}"
+            for c in old
+            if isinstance(c, dict) and isinstance(c.get("name"), str)
+            for ext in (".csv", ".nc")
+        }
+    except (OSError, ValueError, TypeError):
+        pass  # not a folder of cases: only our new files are moved in
+    for f in staged:
+        os.replace(os.path.join(stage, f), os.path.join(target, f))
+    for f in sorted(stale - set(staged)):
+        if os.path.basename(f) == f and os.path.isfile(os.path.join(target, f)):
+            os.unlink(os.path.join(target, f))

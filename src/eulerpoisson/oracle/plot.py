@@ -1,4 +1,10 @@
-"""The figure of a validation: attitude error and invariant drift over time, log scale, exact flips marked."""
+"""The figure of a validation: attitude error and invariant drift over time, log scale, exact flips marked.
+
+The time axis names the run's unit: a ``time_unit`` (or ``units``) attribute
+of the report or of its run when they carry one, else ``s`` as the
+trajectory files say (:mod:`eulerpoisson.io.netcdf`); the legends stand
+outside the axes, at their right, so that they cover no data.
+"""
 
 from __future__ import annotations
 
@@ -12,10 +18,20 @@ if TYPE_CHECKING:
 
     from .compare import ValidationReport
 
-__all__ = ["plot_report"]
+__all__ = ["plot_report", "report_time_unit"]
 
 #: values below this are drawn at this level on the log axes (exact zeros have no logarithm)
 FLOOR = 1e-17
+
+
+def report_time_unit(report) -> str:
+    """The time unit of a validation report: its (or its run's) ``time_unit`` or ``units`` attribute, else ``"s"``."""
+    for obj in (report, getattr(report, "run", None)):
+        for name in ("time_unit", "units"):
+            unit = getattr(obj, name, None)
+            if isinstance(unit, str) and unit.strip():
+                return unit.strip()
+    return "s"
 
 
 def plot_report(
@@ -66,7 +82,7 @@ def plot_report(
     items: list[tuple[str, ValidationReport]] = (
         [("run", report)] if not isinstance(report, (list, tuple)) else list(report)
     )
-    fig = Figure(figsize=(8, 6.5), layout="constrained")
+    fig = Figure(figsize=(9, 6.5), layout="constrained")
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     colors = rcParams["axes.prop_cycle"].by_key()["color"]
     for n, (label, r) in enumerate(items):
@@ -83,11 +99,13 @@ def plot_report(
     for k, tf in enumerate(flips):
         for ax in (ax1, ax2):
             ax.axvline(tf, color="0.6", lw=0.8, ls="-.", label="exact flips" if (k == 0 and ax is ax1) else None)
-    ax1.set_ylabel("attitude error (rad)")
-    ax2.set_ylabel("relative drift of the run")
-    ax2.set_xlabel("t")
-    ax1.legend(fontsize=8, loc="lower right")
-    ax2.legend(fontsize=8, loc="lower right")
+    unit = plain_text(report_time_unit(items[0][1]))
+    ax1.set_ylabel("attitude error [rad]")
+    ax2.set_ylabel("relative drift of the run [1]")
+    ax2.set_xlabel(f"time t [{unit}]")
+    outside = {"loc": "upper left", "bbox_to_anchor": (1.01, 1.0), "borderaxespad": 0.0, "fontsize": 8}
+    ax1.legend(**outside)
+    ax2.legend(**outside)
     ax1.set_title(plain_text(title or f"{items[0][1].source} against the exact motion"))
     if out is not None:
         fig.savefig(out, dpi=110)

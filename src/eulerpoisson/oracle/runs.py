@@ -403,10 +403,16 @@ def read_run(path: str | os.PathLike[str]) -> RawRun:
     if os.path.isdir(path):
         raise InvalidInputError(f"{path} is a directory, not a run (CSV, NetCDF or JSON)")
     ext = os.path.splitext(path)[1].lower()
-    if ext in (".csv", ".txt"):
-        return _read_csv(path)
-    if ext == ".json":
-        return _read_json(path)
+    try:
+        if ext in (".csv", ".txt"):
+            return _read_csv(path)
+        if ext == ".json":
+            return _read_json(path)
+    except UnicodeDecodeError as exc:
+        raise InvalidInputError(
+            f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}); a run's {ext[1:].upper()} file must be "
+            f"UTF-8: save it as UTF-8 (e.g. iconv -f latin1 -t utf-8 {path} > utf8{ext})"
+        ) from None
     if ext in (".nc", ".nc4", ".netcdf"):
         return _read_netcdf(path)
     raise InvalidInputError(

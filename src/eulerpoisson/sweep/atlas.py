@@ -60,8 +60,11 @@ def plot_atlas(
     Raises
     ------
     InvalidInputError
-        Not a sweep dataset, an unknown variable, or a grid with other than
-        two non-trivial axes (select a plane first, e.g. ``ds.isel(I2=0)``).
+        Not a sweep dataset, an unknown variable, a grid with other than
+        two non-trivial axes (select a plane first, e.g. ``ds.isel(I2=0)``),
+        or nothing to draw: no panel has a finite positive value (a sweep of
+        bodies that are not physical). A panel without values (the
+        half-period of a symmetric body) is drawn empty, with a note.
     MissingDependencyError
         matplotlib missing (extra ``plot``).
 
@@ -82,6 +85,9 @@ def plot_atlas(
             raise InvalidInputError(
                 f"variables: {v!r} is not in the sweep; choose from {', '.join(map(str, ds.data_vars))}"
             )
+    drawable = {v: _has_values(ds[v]) for v in variables}
+    if not any(drawable.values()):
+        raise InvalidInputError(_nothing_to_draw(ds, variables))
     mpl = require("matplotlib", "plot")
     from matplotlib.colors import LogNorm
     from matplotlib.figure import Figure
@@ -102,6 +108,9 @@ def plot_atlas(
         x, y = ds["azimuth"].values, ds["polar"].values
         for ax, v in zip(axes[0], variables):
             z = ds[v].values.astype(float)
+            if not drawable[v]:
+                _empty_panel(ax, ds, v, names.get(v, v))
+                continue
             good = np.isfinite(z) & (z > 0)
             sc = ax.scatter(x[good], y[good], c=z[good], s=6, norm=LogNorm(), cmap="viridis")
             ax.scatter(x[~good], y[~good], c="0.5", s=6)
@@ -123,6 +132,9 @@ def plot_atlas(
             yd, xd = dims
         for ax, v in zip(axes[0], variables):
             z = ds[v].transpose(yd, xd).values.astype(float)
+            if not drawable[v]:
+                _empty_panel(ax, ds, v, names.get(v, v))
+                continue
             zm = np.ma.masked_invalid(np.where(z > 0, z, np.nan))
             cmap = mpl.colormaps["viridis"].with_extremes(bad="white")
             xv, yv = ds[xd].values, ds[yd].values
@@ -151,6 +163,50 @@ def plot_atlas(
     with atomic_path(out, suffix=out.suffix) as tmp:
         fig.savefig(tmp, dpi=dpi, format=out.suffix.lstrip(".") or "png")
     return out
+
+
+def _has_values(var) -> bool:
+    """Whether a variable has a value a logarithmic colour scale can show (finite and > 0)."""
+    z = np.asarray(var.values, dtype=float)
+    return bool(np.any(np.isfinite(z) & (z > 0)))
+
+
+def _status_words(ds) -> str:
+    """'35 not a physical body, 2 symmetric body' for the points of ``ds``."""
+    from .points import STATUS
+
+    codes = np.asarray(ds["status"].values).ravel() if "status" in ds else np.array([], dtype=int)
+    parts = [f"{int(np.count_nonzero(codes == c))} {name}" for c, name in STATUS.items() if np.any(codes == c)]
+    if np.any(codes < 0):
+        parts.append(f"{int(np.count_nonzero(codes < 0))} not computed yet")
+    return ", ".join(parts)
+
+
+def _nothing_to_draw(ds, variables) -> str:
+    src = ds.encoding.get("source")
+    where = f"{src}: " if src else ""
+    statuses = _status_words(ds)
+    why = f" (its points: {statuses})" if statuses else ""
+    hint = ""
+    if "status" in ds and np.all(np.asarray(ds["status"].values) == 3):
+        hint = "; every body of the sweep violates the triangle inequality: sweep physical moments of inertia"
+    return f"{where}nothing to draw: {', '.join(variables)} {'has' if len(variables) == 1 else 'have'} no finite value{why}{hint}"
+
+
+def _empty_panel(ax, ds, v: str, title: str) -> None:
+    """A panel without values: its axes and a note instead of a colour map."""
+    statuses = _status_words(ds)
+    ax.text(
+        0.5,
+        0.5,
+        f"no finite values of {v}" + (f"\n({statuses})" if statuses else ""),
+        ha="center",
+        va="center",
+        transform=ax.transAxes,
+    )
+    ax.set_xticks([])
+    ax.set_yticks([])
+    ax.set_title(title)
 
 
 def _as_plane(ds, values: np.ndarray, yd: str, xd: str) -> np.ndarray:

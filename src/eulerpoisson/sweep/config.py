@@ -17,6 +17,7 @@ TOML schema
     I2 = {start = 1.1, stop = 2.9, num = 19}   # range; add log = true for geometric spacing
     I3 = 3.0
     # instead of I2/I3: ratio21 = I2/I1 and ratio31 = I3/I1 (same value forms)
+    allow_unphysical = false   # true: run even when no body is physical (triangle inequality; NaN results)
 
     [momentum]                 # direction of the initial BODY angular momentum M0
     polar = {start = 0.0, stop = 180.0, num = 91}     # angle from principal axis 3
@@ -25,7 +26,7 @@ TOML schema
     degrees = true             # angles in degrees (default) or radians
 
     [output]
-    path = "atlas.zarr"        # relative to the current folder
+    path = "atlas.zarr"        # a .zarr store in the folder of this file (--out writes elsewhere)
     chunk = 256                # points per task (and per Zarr chunk)
 
     [compute]
@@ -44,6 +45,22 @@ polar angle uniform) within the polar and azimuth ranges. Required keys:
 (``[sweep]`` may be left out for a grid); every other key has the default
 shown. Unknown sections or keys are errors, and every error names the
 section and key.
+
+Where a file writes: ``[output] path`` of a sweep *file* is read in the
+folder of the file (``examples/sweep.toml`` with ``path = "atlas.zarr"``
+writes ``examples/atlas.zarr``) and must stay inside it: an absolute path
+elsewhere or a ``..`` that leaves the folder is refused (a file from
+elsewhere cannot choose where your results go; name another place with
+``--out`` or ``run_sweep(..., path=)``), and it must end in ``.zarr``.
+
+Sizes are checked before anything is allocated: at most
+:data:`MAX_AXIS_VALUES` values on one grid axis and :data:`MAX_POINTS`
+points in a sweep. A sweep in which no body is physical (principal
+moments violating the triangle inequality :math:`I_i + I_j \\ge I_k`, e.g.
+``I = (1, 2, 5)``: every result would be NaN) is refused unless
+``[inertia] allow_unphysical = true`` (``--allow-unphysical``,
+``allow_unphysical=True``); in a sweep that mixes both kinds, the bodies
+that are not physical get status 3 and NaN results.
 """
 
 from __future__ import annotations
@@ -60,13 +77,17 @@ import numpy as np
 
 from ..errors import InvalidInputError
 
-__all__ = ["SweepConfig", "load_config", "is_remote"]
+__all__ = ["SweepConfig", "load_config", "is_remote", "check_physical", "MAX_POINTS", "MAX_AXIS_VALUES"]
 
 #: version of the store format (part of a sweep's fingerprint)
 FORMAT_VERSION = 1
+#: most points of one sweep (a store of 1e10 points is about a terabyte, and each point is solved three times)
+MAX_POINTS = 10**10
+#: most values of one grid axis (the axes are kept in memory and in the store's attributes)
+MAX_AXIS_VALUES = 10**6
 _SCHEMA = {
     "sweep": {"kind", "samples", "seed"},
-    "inertia": {"I1", "I2", "I3", "ratio21", "ratio31"},
+    "inertia": {"I1", "I2", "I3", "ratio21", "ratio31", "allow_unphysical"},
     "momentum": {"polar", "azimuth", "magnitude", "degrees"},
     "output": {"path", "chunk"},
     "compute": {"T", "delta", "scheduler", "workers", "method"},
@@ -118,6 +139,11 @@ def _axis_spec(v, where: str, kind: str, positive: bool) -> dict:
             if "num" not in v:
                 raise InvalidInputError(f"{where}: a grid range needs 'num' (the number of values)")
             num = integer(v["num"], f"{where}.num", 1)
+            if num > MAX_AXIS_VALUES:
+                raise InvalidInputError(
+                    f"{where}.num = {num} is more than {MAX_AXIS_VALUES:,} values on one axis of a grid; "
+                    "use fewer values, or kind = 'random' with samples"
+                )
         else:
             num = integer(v["num"], f"{where}.num", 1) if "num" in v else None
         if log and (start <= 0 or stop <= 0):
@@ -136,6 +162,11 @@ def _grid_values(spec: dict) -> np.ndarray:
     r = spec["range"]
     f = np.geomspace if r["log"] else np.linspace
     return f(r["start"], r["stop"], r["num"])
+
+
+def _axis_size(spec: dict) -> int:
+    """Number of values of a grid axis (without computing them)."""
+    return len(spec["values"]) if "values" in spec else int(spec["range"]["num"])
 
 
 @dataclass(frozen=True)
@@ -160,6 +191,9 @@ class SweepConfig:
     scheduler : str
     workers : int or None
     method : str
+    allow_unphysical : bool
+        Whether a sweep in which no body is physical (triangle inequality violated) runs (status 3,
+        NaN results) instead of being refused; not part of the fingerprint (it changes no result).
 
     Examples
     --------
@@ -186,6 +220,7 @@ class SweepConfig:
     scheduler: str = "local"
     workers: int | None = None
     method: str = "exact"
+    allow_unphysical: bool = False
     source: str = field(default="<dict>", compare=False)
 
     # -- derived --------------------------------------------------------
@@ -205,7 +240,8 @@ class SweepConfig:
         if self.kind == "random":
             assert self.samples is not None  # required for kind = 'random'
             return int(self.samples)
-        return int(np.prod([len(v) for v in self.grid_axes.values()]))
+        specs = {**self.inertia, "polar": self.polar, "azimuth": self.azimuth}
+        return math.prod(_axis_size(specs[name]) for name in self.axis_names)
 
     def fingerprint(self) -> dict:
         """What determines the results (not where or how they are computed)."""
@@ -245,18 +281,153 @@ def check_scheduler(s, where: str) -> str:
     return s
 
 
+def check_store_name(value: str, where: str) -> None:
+    """A sweep writes a Zarr store: its name ends in ``.zarr`` (and holds no control character).
+
+    Raises
+    ------
+    InvalidInputError
+        As said; the message names ``where``.
+    """
+    if any(ord(c) < 32 or ord(c) == 127 for c in value):
+        raise InvalidInputError(f"{where} {value!r}: a file name must not contain control characters (newline, tab)")
+    p = Path(value)
+    if p.suffix != ".zarr" or not p.stem:
+        raise InvalidInputError(
+            f"{where} {value!r}: a sweep writes a Zarr store: name it NAME.zarr (e.g. "
+            f"{(p.stem or 'atlas') + '.zarr'!r})"
+        )
+
+
+def _path_in_folder(value: str, file: Path, name: str) -> str:
+    """``[output] path`` of a sweep file: read in the file's folder, refused when it leaves the folder."""
+    folder = os.path.dirname(str(file))
+    base = os.path.abspath(folder or os.curdir)
+    norm = os.path.normpath(value)
+    full = norm if os.path.isabs(norm) else os.path.normpath(os.path.join(base, norm))
+    try:
+        rel = os.path.relpath(full, base)
+    except ValueError:  # another drive (Windows)
+        rel = os.pardir
+    if rel == os.curdir or rel == os.pardir or rel.startswith(os.pardir + os.sep):
+        raise InvalidInputError(
+            f"{name}: [output] path {value!r} is outside the folder of the sweep file ({base}): a file writes only "
+            "inside its own folder; name another place on the command line with --out (path= in run_sweep)"
+        )
+    check_store_name(value, f"{name}: [output] path")
+    return full if os.path.isabs(norm) else os.path.join(folder, norm)
+
+
+def _interval(spec: dict) -> tuple[float, float]:
+    """Smallest and largest value an axis can take (a list or a range)."""
+    if "values" in spec:
+        return float(min(spec["values"])), float(max(spec["values"]))
+    r = spec["range"]
+    return min(r["start"], r["stop"]), max(r["start"], r["stop"])
+
+
+#: grids of at most this many bodies are checked body by body
+_ENUMERATE_BODIES = 2**20
+
+
+def check_physical(cfg: SweepConfig) -> None:
+    """Refuse a sweep in which no body is physical, unless ``cfg.allow_unphysical``.
+
+    Principal moments are those of a mass distribution only when they
+    satisfy the triangle inequalities :math:`I_i + I_j \\ge I_k`; a body
+    that violates them gets status 3 and NaN results, so a sweep of such
+    bodies only would compute nothing. A sweep that mixes both kinds runs
+    (its summary counts the points of each status). A grid of up to
+    2**20 bodies is checked body by body; a random
+    sweep (or a larger grid) over the box of its axes, exactly: the margin
+    :math:`I_1 + I_2 + I_3 - 2\\max I` is concave and piecewise linear, so
+    its largest value in the box is at a point whose coordinates are
+    bounds of the axes.
+
+    Parameters
+    ----------
+    cfg : SweepConfig
+
+    Raises
+    ------
+    InvalidInertiaError
+        As said; the message gives a body of the sweep.
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import load_config
+    >>> cfg = {"inertia": {"I1": 1.0, "I2": 2.0, "I3": [5.0, 6.0]}, "momentum": {"polar": 45.0, "azimuth": 0.0},
+    ...        "output": {"path": "u.zarr"}, "compute": {"T": 1.0}}
+    >>> try:
+    ...     load_config(cfg)
+    ... except ValueError as err:
+    ...     print(str(err)[:78])
+    <dict>: [inertia] no body of the sweep is physical: all 2 violate the triangle
+    >>> load_config(cfg, allow_unphysical=True).allow_unphysical
+    True
+    """
+    if cfg.allow_unphysical:
+        return
+    import itertools
+
+    from ..errors import InvalidInertiaError
+    from .points import classify
+
+    names = list(cfg.inertia)
+    total = math.prod(_axis_size(cfg.inertia[k]) for k in names) if cfg.kind == "grid" else None
+    if total is not None and total <= _ENUMERATE_BODIES:
+        grids = np.meshgrid(*(_grid_values(cfg.inertia[k]) for k in names), indexing="ij")
+        I = moments_from_axes(cfg, {k: g.ravel() for k, g in zip(names, grids)})
+        how_many = "the body of the sweep is not physical: it" if total == 1 else f"all {total} violate"
+    else:
+        bounds = {k: _interval(cfg.inertia[k]) for k in names}
+        if "ratio21" in bounds:  # the triangle inequalities do not depend on the scale I1
+            bounds["I1"] = (1.0, 1.0)
+        values = sorted({x for b in bounds.values() for x in b})
+        inside = [[v for v in values if bounds[k][0] <= v <= bounds[k][1]] for k in names]
+        corners = np.array(list(itertools.product(*inside)))
+        I = moments_from_axes(cfg, {k: corners[:, i] for i, k in enumerate(names)})
+        how_many = "the ranges of its axes hold only bodies that violate"
+    status = classify(I)
+    if np.any(status != 3):
+        return
+    example = "(" + ", ".join(f"{x:.6g}" for x in I[0]) + ")"
+    what = "it" if total == 1 else "them"
+    raise InvalidInertiaError(
+        f"{cfg.source}: [inertia] no body of the sweep is physical: {how_many} the triangle inequality, e.g. "
+        f"I = {example} (one moment exceeds the sum of the other two: no mass distribution has these moments), "
+        f"so every result would be NaN; to sweep {what} anyway (status 3), pass allow_unphysical=True "
+        "(in a sweep file: [inertia] allow_unphysical = true)"
+    )
+
+
 def is_remote(scheduler: str) -> bool:
     """Whether ``scheduler`` is the address of a cluster (tcp:// or tls://), not one started here."""
     return scheduler.startswith(("tcp://", "tls://"))
 
 
-def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
+def load_config(
+    source: str | os.PathLike[str] | dict[str, Any],
+    *,
+    path: str | os.PathLike[str] | None = None,
+    allow_unphysical: bool | None = None,
+) -> SweepConfig:
     """Read and validate a sweep description.
 
     Parameters
     ----------
     source : str, Path or dict
-        A TOML file or the parsed dictionary (same structure).
+        A TOML file or the parsed dictionary (same structure). The
+        ``[output] path`` of a file is read in the file's folder and must
+        stay inside it and end in ``.zarr``; that of a dictionary is used
+        as it is.
+    path : str or Path, optional
+        The output store, chosen by the caller: replaces ``[output] path``
+        (which is then not checked).
+    allow_unphysical : bool, optional
+        Replaces ``[inertia] allow_unphysical`` (default false): whether a
+        sweep in which no body is physical runs (status 3, NaN results)
+        instead of being refused.
 
     Returns
     -------
@@ -268,7 +439,13 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
         No such file.
     InvalidInputError
         Invalid TOML, an unknown section or key, a missing key, a value of
-        the wrong type or out of range; the message names ``[section] key``.
+        the wrong type or out of range, more than :data:`MAX_POINTS` points
+        or :data:`MAX_AXIS_VALUES` values on a grid axis, an ``[output]
+        path`` of a file outside its folder or not ending in ``.zarr``; the
+        message names ``[section] key``.
+    InvalidInertiaError
+        No body of the sweep is physical and ``allow_unphysical`` is false
+        (see :func:`check_physical`).
 
     Examples
     --------
@@ -282,12 +459,25 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
     >>> cfg = load_config("sweep.toml")
     >>> cfg.inertia["I2"], cfg.path
     ({'range': {'start': 1.5, 'stop': 2.5, 'num': 3, 'log': False}}, 'atlas.zarr')
+    >>> import os
+    >>> os.makedirs("sweeps", exist_ok=True)
+    >>> with open("sweeps/escape.toml", "w") as fh:
+    ...     for line in toml:
+    ...         print(line.replace('"atlas.zarr"', '"../../atlas.zarr"'), file=fh)
+    >>> try:
+    ...     load_config("sweeps/escape.toml")
+    ... except ValueError as err:
+    ...     print(str(err)[:75])
+    sweeps/escape.toml: [output] path '../../atlas.zarr' is outside the folder
+    >>> load_config("sweeps/escape.toml", path="mine.zarr").path
+    'mine.zarr'
     >>> try:
     ...     load_config({"inertia": {"I1": 1.0}})
     ... except ValueError as err:
     ...     print(err)
     <dict>: missing section [momentum]
     """
+    file: Path | None = None
     if isinstance(source, dict):
         cfg, name = source, "<dict>"
     else:
@@ -301,7 +491,9 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
                 cfg = tomllib.load(fh)
         except tomllib.TOMLDecodeError as exc:
             raise InvalidInputError(f"{p}: invalid TOML: {exc}") from None
-        name = str(p)
+        except RecursionError:
+            raise InvalidInputError(f"{p}: invalid TOML: nested too deeply (a sweep file has two levels)") from None
+        name, file = str(p), p
 
     for sec, body in cfg.items():
         if sec not in _SCHEMA:
@@ -347,6 +539,11 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
         if key not in inn:
             raise InvalidInputError(f"{name}: [inertia] {key} is required")
     inertia = {key: _axis_spec(inn[key], f"{name}: [inertia] {key}", kind, True) for key in names}
+    allow = inn.get("allow_unphysical", False)
+    if not isinstance(allow, bool):
+        raise InvalidInputError(f"{name}: [inertia] allow_unphysical must be true or false, got {allow!r}")
+    if allow_unphysical is not None:
+        allow = bool(allow_unphysical)
 
     mo = cfg["momentum"]
     degrees = mo.get("degrees", True)
@@ -360,10 +557,26 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
             raise InvalidInputError(f"{name}: [momentum] polar must lie in [0, {top:g}], got {v!r}")
     magnitude = _real(mo.get("magnitude", 1.0), f"{name}: [momentum] magnitude", positive=True)
 
+    if kind == "random":
+        assert samples is not None
+        n_points = samples
+    else:
+        n_points = math.prod(_axis_size(s) for s in (*inertia.values(), polar, azimuth))
+    if n_points > MAX_POINTS:
+        what = "[sweep] samples" if kind == "random" else "the grid"
+        raise InvalidInputError(
+            f"{name}: {what} has {n_points:.3g} points, more than {MAX_POINTS:,} (a store of about "
+            f"{n_points * 113 / 1e12:.3g} TB, and each point is solved three times); sweep fewer points"
+        )
+
     out = cfg["output"]
-    path = out["path"]
-    if not isinstance(path, str) or not path.strip():
-        raise InvalidInputError(f"{name}: [output] path must be a non-empty string, got {path!r}")
+    given = out["path"]
+    if not isinstance(given, str) or not given.strip():
+        raise InvalidInputError(f"{name}: [output] path must be a non-empty string, got {given!r}")
+    if path is not None:
+        given = os.fspath(path)  # the caller's choice: the file's path is not used
+    elif file is not None:
+        given = _path_in_folder(given, file, name)
     chunk = integer(out.get("chunk", 256), f"{name}: [output] chunk", 1)
 
     co = cfg["compute"]
@@ -386,7 +599,7 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
         raise InvalidInputError(
             f"{name}: [compute] method: unknown method {method!r}; available: {', '.join(available_methods())}"
         )
-    return SweepConfig(
+    config = SweepConfig(
         kind=kind,
         samples=samples,
         seed=seed,
@@ -395,15 +608,18 @@ def load_config(source: str | os.PathLike[str] | dict[str, Any]) -> SweepConfig:
         azimuth=azimuth,
         magnitude=magnitude,
         degrees=degrees,
-        path=path,
+        path=given,
         chunk=chunk,
         T=T,
         delta=delta,
         scheduler=scheduler,
         workers=workers,
         method=method,
+        allow_unphysical=allow,
         source=name,
     )
+    check_physical(config)
+    return config
 
 
 # ---------------------------------------------------------------------------

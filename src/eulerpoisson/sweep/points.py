@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
 
-__all__ = ["compute_points", "STATUS"]
+__all__ = ["compute_points", "STATUS", "classify"]
 
 #: meaning of the ``status`` codes
 STATUS = {0: "regular", 1: "separatrix", 2: "symmetric body", 3: "not a physical body"}
@@ -24,13 +24,16 @@ _TOL = 1e-12  # same relative tolerance as RigidBody's degeneracy checks
 # ---------------------------------------------------------------------------
 # the computation of one chunk
 # ---------------------------------------------------------------------------
-def _classify(I: np.ndarray) -> np.ndarray:
+def classify(I: np.ndarray) -> np.ndarray:
     """Status 0 (asymmetric, physical), 2 (symmetric) or 3 (not a physical body) per row of I (m, 3)."""
     s = np.sort(I, -1)
     tol = _TOL * np.sum(np.abs(s), -1)
     bad = (s[:, 0] <= 0) | (s[:, 0] + s[:, 1] - s[:, 2] < -tol)
     sym = (s[:, 1] - s[:, 0] <= tol) | (s[:, 2] - s[:, 1] <= tol)
     return np.where(bad, 3, np.where(sym, 2, 0)).astype(np.int8)
+
+
+_classify = classify  # the former name
 
 
 def _rotation_angle(q1: np.ndarray, q2: np.ndarray) -> np.ndarray:
@@ -114,7 +117,7 @@ def compute_points(
     if np.any(L == 0):
         raise InvalidInputError("M0 contains a zero angular momentum (a body at rest has no flips)")
     P = I.shape[0]
-    status = _classify(I)
+    status = classify(I)
     k2 = np.full(P, np.nan)
     k2c = np.full(P, np.nan)
     lam = np.full(P, np.nan)

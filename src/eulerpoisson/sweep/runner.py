@@ -68,9 +68,11 @@ J. Dyn. Diff. Eq. 3 (1991) 67-85.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
 import os
+import shutil
 import time as _time
 from collections.abc import Callable
 from datetime import UTC, datetime
@@ -89,6 +91,7 @@ from .atlas import plot_atlas
 from .config import (
     FORMAT_VERSION,
     SweepConfig,
+    check_physical,
     check_scheduler,
     direction,
     grid_points,
@@ -108,6 +111,7 @@ __all__ = [
     "load_sweep",
     "plot_atlas",
     "STATUS",
+    "sweep_summary",
 ]
 
 # The task of a sweep, looked up here by run_sweep at call time (so that it can be replaced on this
@@ -235,6 +239,18 @@ def _create_store(zarr, store: Path, cfg: SweepConfig) -> None:
         g["M0"][a:b] = cfg.magnitude * direction(v["polar"], v["azimuth"], cfg.degrees)
 
 
+#: bytes of memory per point of a random sweep while its points are drawn (its five axes, M0, temporaries)
+_RANDOM_BYTES_PER_POINT = 8 * 12
+
+
+def _memory_available() -> float | None:
+    """Available memory in bytes (None where the system does not say)."""
+    try:
+        return float(os.sysconf("SC_AVPHYS_PAGES")) * float(os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        return None
+
+
 def _local_cluster(workers):
     distributed = require("distributed", "dask")
     n = workers or os.cpu_count() or 1
@@ -258,6 +274,7 @@ def run_sweep(
     client: Any = None,
     progress: bool | Callable[[int, int], object] | None = None,
     overwrite: bool = False,
+    allow_unphysical: bool | None = None,
 ) -> Path:
     """Run (or resume) a sweep and write its Zarr store.
 
@@ -284,6 +301,10 @@ def run_sweep(
     overwrite : bool
         Discard an existing result or a partial sweep made with a different
         configuration.
+    allow_unphysical : bool, optional
+        Run a sweep in which no body is physical (status 3, NaN results)
+        instead of refusing it; default ``[inertia] allow_unphysical``
+        (false). See :func:`~eulerpoisson.sweep.config.check_physical`.
 
     Returns
     -------
@@ -294,7 +315,11 @@ def run_sweep(
     Raises
     ------
     InvalidInputError
-        Invalid configuration or scheduler.
+        Invalid configuration or scheduler; a random sweep whose points do
+        not fit in the available memory.
+    InvalidInertiaError
+        No body of the sweep is physical and ``allow_unphysical`` is not
+        true.
     FileExistsError
         ``path`` holds a different sweep (or something else) and
         ``overwrite`` is False.
@@ -302,6 +327,8 @@ def run_sweep(
         A partial sweep with a different configuration is in the way.
     MissingDependencyError
         zarr (or dask/distributed for a cluster) is not installed (extra ``dask``).
+    EulerPoissonError
+        The scheduler cannot be reached (checked before anything is written).
     KeyboardInterrupt
         Propagated after the finished chunks are recorded; rerun to resume.
 
@@ -309,6 +336,8 @@ def run_sweep(
     -----
     Finished chunks are written by the client (so remote workers need no
     shared file system) and then recorded by a marker; a rerun skips them.
+    A sweep that fails (other than by an interruption) before its first
+    chunk is finished leaves nothing behind: its work folder is removed.
     Workers of a remote cluster need eulerpoisson installed (the task is
     :func:`compute_points`, shipped by reference).
 
@@ -337,7 +366,11 @@ def run_sweep(
      [  6.469547   8.917193]]
     """
     zarr = require("zarr", "dask")
-    cfg = config if isinstance(config, SweepConfig) else load_config(config)
+    if isinstance(config, SweepConfig):
+        cfg = config if allow_unphysical is None else config.replace(allow_unphysical=bool(allow_unphysical))
+        check_physical(cfg)
+    else:
+        cfg = load_config(config, path=path, allow_unphysical=allow_unphysical)
     if scheduler is None and client is None and is_remote(cfg.scheduler):
         raise InvalidInputError(
             f"the sweep file names the scheduler {cfg.scheduler!r}; a file never connects to a cluster on its own: "
@@ -349,6 +382,15 @@ def run_sweep(
     else:
         workers = cfg.workers
     path = Path(path if path is not None else cfg.path)
+    if cfg.kind == "random" and not work_dir(path).exists():
+        # its points are drawn at once when the store is made: check that they fit before anything is written
+        need = float(cfg.n_points) * _RANDOM_BYTES_PER_POINT
+        free = _memory_available()
+        if free is not None and need > free:
+            raise InvalidInputError(
+                f"{cfg.source}: [sweep] samples = {cfg.n_points} needs about {need / 2**30:.3g} GiB in memory to "
+                f"draw its points, more than the {free / 2**30:.3g} GiB available; sweep fewer points"
+            )
     fp = cfg.fingerprint()
     fp_text = json.dumps(fp, sort_keys=True)
 
@@ -370,16 +412,56 @@ def run_sweep(
             _create_store(zarr, store, cfg)
             zarr.consolidate_metadata(str(store))  # the partial store reads like the final one
 
-    partial.create(make_store)
+    n, chunk = cfg.n_points, cfg.chunk
+    nchunks = -(-n // chunk)
+    todo = [k for k in range(nchunks) if k not in done]
+    fresh = not partial.work.exists()
+    with contextlib.ExitStack() as stack:
+        if todo and client is None and scheduler != "serial":
+            # reach the cluster first: a scheduler that cannot be reached leaves nothing behind
+            client = _connect(stack, scheduler, workers)
+        try:
+            partial.create(make_store)
+            _compute(zarr, cfg, store, partial, todo, client, workers, progress, path)
+        except BaseException as exc:
+            if fresh and not partial.done and not isinstance(exc, KeyboardInterrupt):
+                shutil.rmtree(partial.work, ignore_errors=True)  # a failure before any chunk finished: nothing to keep
+            if isinstance(exc, KeyboardInterrupt):
+                exc.add_note(
+                    f"eulerpoisson: the finished chunks of the sweep are kept in {store}; rerun the sweep to resume "
+                    "(run_sweep with the same configuration and path: only the missing chunks are computed)"
+                )
+            raise
 
+    with quiet_zarr():
+        g = zarr.open_group(str(store), mode="r+")
+        g.attrs["history"] = f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
+        zarr.consolidate_metadata(str(store))
+    partial.publish()
+    return path
+
+
+def _connect(stack: contextlib.ExitStack, scheduler: str, workers):
+    """A client of the embedded cluster (``"local"``) or of the scheduler at an address, closed by ``stack``."""
+    distributed = require("distributed", "dask")
+    if scheduler == "local":
+        cluster = stack.enter_context(_local_cluster(workers))
+        return stack.enter_context(distributed.Client(cluster, set_as_default=False))
+    try:
+        return stack.enter_context(distributed.Client(scheduler, set_as_default=False))
+    except OSError as exc:
+        raise EulerPoissonError(f"cannot connect to the Dask scheduler {scheduler}: {exc}") from exc
+
+
+def _compute(zarr, cfg, store, partial, todo, client, workers, progress, path) -> None:
+    """Compute the chunks ``todo`` of the sweep, writing each to ``store`` and marking it done."""
     with quiet_zarr():
         g = zarr.open_group(str(store), mode="r+")
         arrs = {
             name: g[name] for name in ("I1", "I2", "I3", "M0", *_RESULTS, "chunk_count", "chunk_seconds", "chunk_time")
         }
     n, chunk = cfg.n_points, cfg.chunk
-    nchunks = -(-n // chunk)
-    todo = [k for k in range(nchunks) if k not in done]
+    done = partial.done
 
     def bounds(k):
         return k * chunk, min(n, (k + 1) * chunk)
@@ -403,77 +485,108 @@ def run_sweep(
 
     n_done = sum(bounds(k)[1] - bounds(k)[0] for k in done)
     args = (cfg.T, cfg.delta, cfg.method, n)
-    try:
-        with ProgressDisplay(progress, n, f"sweep {path.name}") as bar:
-            bar.update(n_done)
-            if todo and client is None and scheduler == "serial":
-                for k in todo:
-                    I, M = inputs(k)
-                    write(k, _compute_chunk(I, M, *args, workers))
-                    n_done += bounds(k)[1] - bounds(k)[0]
-                    bar.update(n_done)
-            elif todo:
-                n_done = _run_distributed(client, scheduler, workers, todo, inputs, write, args, bounds, bar, n_done)
-    except KeyboardInterrupt as exc:
-        exc.add_note(f"eulerpoisson: the finished chunks of the sweep are kept in {store}; rerun the sweep to resume")
-        raise
-
-    with quiet_zarr():
-        g.attrs["history"] = f"{g.attrs.get('history', '')}; finished {datetime.now(UTC).isoformat(timespec='seconds')}"
-        zarr.consolidate_metadata(str(store))
-    partial.publish()
-    return path
-
-
-def _run_distributed(client, scheduler, workers, todo, inputs, write, args, bounds, bar, n_done):
-    distributed = require("distributed", "dask")
-    import contextlib
-
-    with contextlib.ExitStack() as stack:
-        if client is None:
-            if scheduler == "local":
-                cluster = stack.enter_context(_local_cluster(workers))
-                client = stack.enter_context(distributed.Client(cluster, set_as_default=False))
-            else:
-                try:
-                    client = stack.enter_context(distributed.Client(scheduler, set_as_default=False))
-                except OSError as exc:
-                    raise EulerPoissonError(f"cannot connect to the Dask scheduler {scheduler}: {exc}") from exc
-        nthreads = max(1, sum(client.nthreads().values()))
-        window = 4 * nthreads  # tasks in flight: bounded, so huge sweeps need no huge graphs
-        pending = iter(todo)
-        keys = {}
-
-        def submit_next():
-            k = next(pending, None)
-            if k is None:
-                return None
-            I, M = inputs(k)
-            fut = client.submit(_compute_chunk, I, M, *args, 1, pure=False)
-            keys[fut.key] = k
-            return fut
-
-        first = [f for f in (submit_next() for _ in range(window)) if f is not None]
-        ac = distributed.as_completed(first, loop=client.loop, with_results=True)
-        try:
-            for fut, res in ac:
-                k = keys.pop(fut.key)
-                write(k, res)
+    with ProgressDisplay(progress, n, f"sweep {path.name}") as bar:
+        bar.update(n_done)
+        if todo and client is None:  # serial
+            for k in todo:
+                I, M = inputs(k)
+                write(k, _compute_chunk(I, M, *args, workers))
                 n_done += bounds(k)[1] - bounds(k)[0]
                 bar.update(n_done)
-                fut = submit_next()
-                if fut is not None:
-                    ac.add(fut)
-        except BaseException:
-            for f in list(ac.futures):
-                f.cancel()
-            raise
+        elif todo:
+            _run_distributed(client, todo, inputs, write, args, bounds, bar, n_done)
+
+
+def _run_distributed(client, todo, inputs, write, args, bounds, bar, n_done):
+    distributed = require("distributed", "dask")
+    nthreads = max(1, sum(client.nthreads().values()))
+    window = 4 * nthreads  # tasks in flight: bounded, so huge sweeps need no huge graphs
+    pending = iter(todo)
+    keys = {}
+
+    def submit_next():
+        k = next(pending, None)
+        if k is None:
+            return None
+        I, M = inputs(k)
+        fut = client.submit(_compute_chunk, I, M, *args, 1, pure=False)
+        keys[fut.key] = k
+        return fut
+
+    first = [f for f in (submit_next() for _ in range(window)) if f is not None]
+    ac = distributed.as_completed(first, loop=client.loop, with_results=True)
+    try:
+        for fut, res in ac:
+            k = keys.pop(fut.key)
+            write(k, res)
+            n_done += bounds(k)[1] - bounds(k)[0]
+            bar.update(n_done)
+            fut = submit_next()
+            if fut is not None:
+                ac.add(fut)
+    except BaseException:
+        for f in list(ac.futures):
+            f.cancel()
+        raise
     return n_done
 
 
 # ---------------------------------------------------------------------------
 # reading a sweep
 # ---------------------------------------------------------------------------
+def sweep_summary(path: str | os.PathLike[str]) -> dict[str, int]:
+    """How many points of a sweep store have each status (read chunk by chunk: memory stays bounded).
+
+    Parameters
+    ----------
+    path : str or Path
+        A sweep store (finished, or the partial store of an unfinished sweep).
+
+    Returns
+    -------
+    dict of int
+        ``points`` (all of them), one count per name of :data:`STATUS`
+        (``regular``, ``separatrix``, ``symmetric body``, ``not a physical
+        body``) and ``unfinished`` (points not computed yet).
+
+    Raises
+    ------
+    EulerPoissonError
+        Not a sweep store.
+    MissingDependencyError
+        zarr missing.
+
+    Examples
+    --------
+    >>> from eulerpoisson.sweep import run_sweep
+    >>> from eulerpoisson.sweep.runner import sweep_summary
+    >>> cfg = {"inertia": {"I1": 1.0, "I2": 2.0, "I3": [3.0, 2.0]}, "momentum": {"polar": [0.0, 45.0], "azimuth": 0.0},
+    ...        "output": {"path": "summary.zarr"}, "compute": {"T": 1.0, "scheduler": "serial"}}
+    >>> sweep_summary(run_sweep(cfg, progress=False))
+    {'points': 4, 'regular': 2, 'separatrix': 0, 'symmetric body': 2, 'not a physical body': 0, 'unfinished': 0}
+    """
+    zarr = require("zarr", "dask")
+    p = Path(path)
+    try:
+        with quiet_zarr():
+            g = zarr.open_group(str(p), mode="r")
+            status = g["status"]
+            chunk = int(g.attrs.get("chunk", 0)) or int(status.chunks[0])
+    except Exception as exc:
+        raise EulerPoissonError(f"{p} is not an eulerpoisson sweep store ({exc})") from exc
+    n = int(status.shape[0])
+    counts = np.zeros(len(STATUS) + 1, dtype=np.int64)  # -1 (unfinished), then the status codes
+    step = chunk * max(1, 2**22 // chunk)
+    for a in range(0, n, step):
+        with quiet_zarr():
+            s = np.asarray(status[a : min(n, a + step)]).astype(np.int64)
+        counts += np.bincount(np.clip(s, -1, len(STATUS) - 1) + 1, minlength=len(STATUS) + 1)
+    out = {"points": n}
+    out.update({name: int(counts[code + 1]) for code, name in STATUS.items()})
+    out["unfinished"] = int(counts[0])
+    return out
+
+
 def load_sweep(path: str | os.PathLike[str], *, squeeze: bool = True) -> xr.Dataset:
     """Read a sweep store as an :class:`xarray.Dataset`.
 
@@ -528,6 +641,7 @@ def load_sweep(path: str | os.PathLike[str], *, squeeze: bool = True) -> xr.Data
         raise EulerPoissonError(f"{p} is not a readable Zarr store: {exc}") from exc
     if "sweep_config" not in ds.attrs or "half_period" not in ds:
         raise EulerPoissonError(f"{p} is not an eulerpoisson sweep store")
+    ds.encoding["source"] = str(p)  # named by plot_atlas's messages
     if ds.attrs.get("sweep_kind") != "grid":
         return ds
     grid = json.loads(ds.attrs["sweep_grid"])
@@ -548,4 +662,5 @@ def load_sweep(path: str | os.PathLike[str], *, squeeze: bool = True) -> xr.Data
     out = xr.Dataset(data, coords={**coords, "axis": ds["axis"].values}, attrs=dict(ds.attrs))
     if squeeze:
         out = out.squeeze([d for d, s in zip(names, shape) if s == 1])
+    out.encoding["source"] = str(p)
     return out

@@ -41,6 +41,8 @@ class Piece(NamedTuple):
     n: int
     tmin: float
     tmax: float
+    total: np.ndarray | None = None  # (m, k) sums of the finite samples, with means=True
+    finite: np.ndarray | None = None  # (m, k) numbers of finite samples, with means=True
 
 
 class MinMaxEnvelope:
@@ -54,9 +56,20 @@ class MinMaxEnvelope:
         Number of series.
     nbins : int
         Number of columns.
+    means : bool
+        Also keep the sum of the (finite) samples of every column, for
+        :meth:`means` (one more pass over the samples).
+
+    Examples
+    --------
+    >>> env = MinMaxEnvelope(0.0, 1.0, 1, nbins=2, means=True)
+    >>> env.add(np.array([0.0, 0.2, 0.6, 0.9]), np.array([1.0, 3.0, -1.0, 5.0]))
+    >>> env.means()
+    (array([0.25, 0.75]), array([[2.],
+           [2.]]))
     """
 
-    def __init__(self, t0: float, t1: float, k: int, nbins: int = DEFAULT_BINS):
+    def __init__(self, t0: float, t1: float, k: int, nbins: int = DEFAULT_BINS, *, means: bool = False):
         self.t0, self.t1 = float(t0), float(t1)
         self.nbins = int(nbins)
         self.k = int(k)
@@ -64,6 +77,9 @@ class MinMaxEnvelope:
         self.hi = np.full((self.nbins, self.k), -np.inf)
         self.count = np.zeros(self.nbins, dtype=np.int64)
         self.samples = 0
+        self.keep_means = bool(means)
+        self.total = np.zeros((self.nbins, self.k)) if means else None
+        self.finite = np.zeros((self.nbins, self.k), dtype=np.int64) if means else None
 
     def bins_of(self, t) -> np.ndarray:
         """Column of every time."""
@@ -119,6 +135,14 @@ class MinMaxEnvelope:
             np.fmax.at(hi[:, j], b[ok], yj[ok])
         count = np.bincount(b, minlength=self.nbins)
         used = np.flatnonzero(count)
+        total = finite = None
+        if self.keep_means:
+            total = np.zeros((used.size, self.k))
+            finite = np.zeros((used.size, self.k), dtype=np.int64)
+            for j, yj in enumerate(cols):
+                ok = ~np.isnan(yj)
+                total[:, j] = np.bincount(b[ok], weights=yj[ok], minlength=self.nbins)[used]
+                finite[:, j] = np.bincount(b[ok], minlength=self.nbins)[used]
         empty = ~(lo[used] <= hi[used])
         with np.errstate(invalid="ignore"):
             return Piece(
@@ -129,6 +153,8 @@ class MinMaxEnvelope:
                 n,
                 float(np.min(t)),
                 float(np.max(t)),
+                total,
+                finite,
             )
 
     def _starts(self, t) -> np.ndarray:
@@ -179,6 +205,12 @@ class MinMaxEnvelope:
         for j, yj in enumerate(cols):
             lo[:, j] = np.minimum.reduceat(yj, starts)
             hi[:, j] = np.maximum.reduceat(yj, starts)
+        total = finite = None
+        if self.keep_means:
+            total = np.empty((starts.size, self.k))
+            for j, yj in enumerate(cols):
+                total[:, j] = np.add.reduceat(yj, starts)
+            finite = np.repeat((ends - starts)[:, None], self.k, axis=1)
         bad = np.isnan(lo) | np.isnan(hi)
         if bad.any():  # a column with NaN samples: their extremes without them (NaN when all are NaN)
             with np.errstate(invalid="ignore"):
@@ -186,7 +218,11 @@ class MinMaxEnvelope:
                     seg = cols[j][starts[c] : ends[c]]
                     lo[c, j] = np.fmin.reduce(seg)
                     hi[c, j] = np.fmax.reduce(seg)
-        return Piece(bins, lo, hi, ends - starts, n, tmin, tmax)
+                    if total is not None and finite is not None:
+                        ok = ~np.isnan(seg)
+                        total[c, j] = np.sum(seg[ok])
+                        finite[c, j] = int(np.count_nonzero(ok))
+        return Piece(bins, lo, hi, ends - starts, n, tmin, tmax, total, finite)
 
     def merge(self, piece) -> None:
         """Add the extremes of a piece reduced by :meth:`reduce` (of this envelope, or one with the same columns)."""
@@ -195,7 +231,34 @@ class MinMaxEnvelope:
             self.lo[c] = np.fmin(self.lo[c], piece.lo)
             self.hi[c] = np.fmax(self.hi[c], piece.hi)
             self.count[c] += piece.count
+            if self.total is not None and self.finite is not None and piece.total is not None:
+                self.total[c] += piece.total
+                self.finite[c] += piece.finite
         self.samples += piece.n
+
+    def bands(self):
+        """``(x, lo, hi)``: the centre of every non-empty column (m,) and the extremes there (m, k), NaN where none."""
+        used = np.flatnonzero(self.count > 0)
+        xc = self.t0 + (used + 0.5) * ((self.t1 - self.t0) / self.nbins)
+        lo, hi = self.lo[used], self.hi[used]
+        empty = ~(lo <= hi)
+        return xc, np.where(empty, np.nan, lo), np.where(empty, np.nan, hi)
+
+    def means(self):
+        """``(x, mean)``: the centre of every non-empty column (m,) and the mean of its finite samples (m, k).
+
+        Raises
+        ------
+        ValueError
+            The envelope was made without ``means=True``.
+        """
+        if self.total is None or self.finite is None:
+            raise ValueError("this envelope keeps no sums: make it with MinMaxEnvelope(..., means=True)")
+        used = np.flatnonzero(self.count > 0)
+        xc = self.t0 + (used + 0.5) * ((self.t1 - self.t0) / self.nbins)
+        f = self.finite[used]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return xc, np.where(f > 0, self.total[used] / np.maximum(f, 1), np.nan)
 
     def points(self):
         """``(x, y)``: two points per non-empty column at its centre, ``x`` (2m,), ``y`` (2m, k).

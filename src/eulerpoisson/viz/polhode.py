@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from .long_runs import body_model
 from .long_runs import thin as _thin
 from .plot_common import AXIS_COLORS, STYLE, import_matplotlib, select_body
 from .plot_common import MAX_3D_POINTS as _MAX_3D_POINTS
@@ -38,6 +39,7 @@ if TYPE_CHECKING:
 __all__ = [
     "plot_polhode",
     "sphere_conic",
+    "TORQUE_NOTE",
 ]
 
 
@@ -158,6 +160,14 @@ def plot_polhode(
     through the intermediate axis (black), ``family`` further polhodes on each
     side (light), a wireframe sphere and the principal axes.
 
+    Under torque :math:`|\mathbf M|` and the kinetic energy change, so the
+    sphere and the polhodes of the free body do not hold: only the path
+    :math:`\mathbf M(t)` and the principal axes are drawn, with what the
+    model conserves in this space — for a Lagrange top (symmetric body, centre
+    of mass on its axis, under gravity) the plane
+    :math:`\mathbf M\cdot\mathbf e_3 = M_3(t_0)` of the constant component
+    along the symmetry axis — and a note on the figure says so.
+
     Parameters
     ----------
     traj, ax, fig, index
@@ -178,17 +188,23 @@ def plot_polhode(
     """
     traj = _thin(traj, _MAX_3D_POINTS)  # a long run (or a store): evenly strided, read piece by piece
     one = select_body(traj, index)
+    model = body_model(traj, index)
     mpl = import_matplotlib()
     Mp = one.M @ one.axes  # principal components P^T M, (T, 3)
     k = one.first
     L = float(np.linalg.norm(Mp[k]))
     I = one.moments
-    lim = 1.2 * (L if L > 0 else 1.0)
+    free = model.is_free
+    if free:
+        lim = 1.2 * (L if L > 0 else 1.0)
+    else:
+        big = float(np.max(np.linalg.norm(Mp, axis=-1)))
+        lim = 1.2 * (big if big > 0 else 1.0)
     with mpl.rc_context(STYLE):
         fig, ax = _new_axes(ax, fig, True, (6.2, 6.0))
         unit = f"kg m²/{one.unit}"
         _setup_3d(ax, lim, [f"M{str(i + 1).translate(_SUB)} [{unit}]" for i in range(3)])
-        if L > 0:
+        if free and L > 0:
             _unit_sphere(ax, L, alpha=0.12)
             a = 1.0 / I
             order = np.argsort(a)
@@ -214,6 +230,9 @@ def plot_polhode(
                 ax.plot(
                     *cur.T, color="#ff7f0e", lw=1.2, ls="--", label="|M| = L ∩ energy ellipsoid" if ic == 0 else None
                 )
+        note = None
+        if not free:
+            note = _conserved_under_torque(ax, model, one, Mp)
         # principal axes
         for i in range(3):
             e = np.eye(3)[i] * lim
@@ -226,9 +245,51 @@ def plot_polhode(
                 ha="center",
             )
         sl = _stride(len(Mp))
-        kw = {"color": "#8c1d8c", "lw": 2.2, **style}
+        kw = {"color": "#8c1d8c", "lw": 2.2 if free else 1.4, **style}
         ax.plot(*Mp[sl].T, label="M(t) computed", **kw)
         ax.scatter(*Mp[k], color="#8c1d8c", s=25, depthshade=False, label="M(t₀)")
         ax.legend(loc="upper left", fontsize=8)
-        ax.set_title(_title(one, "Polhode: body angular momentum M(t) on |M| = L"))
+        if free:
+            ax.set_title(_title(one, "Polhode: body angular momentum M(t) on |M| = L"))
+        else:
+            torques = ", ".join(dict.fromkeys(type(tq).__name__ for tq in model.torques))
+            ax.set_title(_title(one, f"Body angular momentum M(t) under torque ({torques})"))
+            ax.text2D(
+                0.5,
+                0.0,
+                note,
+                transform=ax.transAxes,
+                ha="center",
+                va="bottom",
+                fontsize=8,
+                color="0.25",
+                wrap=True,
+            )
     return fig
+
+
+#: the note of a polhode picture under torque (no sphere, no polhodes)
+TORQUE_NOTE = "under torque |M| and the kinetic energy change: no momentum sphere, no polhodes drawn"
+
+
+def _conserved_under_torque(ax, model, one, Mp) -> str:
+    """Draw what the torque model conserves in the space of M (a Lagrange top: the plane M·e₃ = const); the note."""
+    lt = model.lagrange_top()
+    if lt is None:
+        return TORQUE_NOTE + "; this model conserves nothing in this space"
+    c = np.asarray(lt.frame, dtype=float)[..., :, 2]  # the symmetry axis (through the centre of mass), body frame
+    u = one.axes.T @ c  # ... in the principal frame of the picture
+    u = u / np.linalg.norm(u)
+    M3 = float(Mp[one.first] @ u)
+    across = Mp - np.outer(Mp @ u, u)
+    r = 1.15 * max(float(np.max(np.linalg.norm(across, axis=-1))), 1e-3 * float(np.max(np.abs(Mp))) or 1.0)
+    e1 = np.cross(u, np.eye(3)[int(np.argmin(np.abs(u)))])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(u, e1)
+    th = np.linspace(0.0, 2.0 * np.pi, 181)
+    ring = M3 * u + r * (np.cos(th)[:, None] * e1 + np.sin(th)[:, None] * e2)
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    ax.add_collection3d(Poly3DCollection([ring], facecolor="#ff7f0e", alpha=0.12, edgecolor="none"))
+    ax.plot(*ring.T, color="#ff7f0e", lw=1.2, ls="--", label="M·e₃ = M₃(t₀): conserved (Lagrange top)")
+    return TORQUE_NOTE + "; a Lagrange top keeps M₃ = M·e₃ (symmetry axis): the path stays in that plane"

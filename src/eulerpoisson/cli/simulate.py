@@ -88,7 +88,7 @@ def solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, kee
     """
     from ..io.stream import ProgressDisplay
     from ..model.drift import DriftAccumulator
-    from ..solvers.engine import TimeGrid, collect, merge_stats, prepare_run
+    from ..solvers.engine import Segment, TimeGrid, collect, merge_stats, prepare_run
     from ..trajectory import Trajectory
 
     run = prepare_run(
@@ -104,7 +104,8 @@ def solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, kee
     )
     show = progress if (samples >= CHUNKED_SAMPLES or len(run.bounds) > 1) else False
     start = time.perf_counter()
-    pieces: list = []  # the segments (keep) or their counters
+    pieces: list[Segment] = []  # (keep)
+    counters: list[dict] = []  # the segments' stats (not keep)
     acc = None if keep else DriftAccumulator(model)
     first = last = None
     with ProgressDisplay(show, samples, f"{run.method_name}: solving") as bar:
@@ -116,14 +117,14 @@ def solve_run(model, t_end, samples, omega0, m0, q0, method, opts, progress, kee
                 acc.update(tr.t, tr.quaternion, tr.omega)
                 first = tr[[0]] if first is None else first
                 last = tr[[-1]]
-                pieces.append(seg.trajectory.stats)
+                counters.append(tr.stats)
             bar.update(seg.stop)
     if acc is None:
         return collect(run, pieces)
     assert first is not None and last is not None  # at least one sample
-    stats = merge_stats(run.method, pieces)
-    if len(pieces) > 1:
-        stats["segments"] = len(pieces)
+    stats = merge_stats(run.method, counters)
+    if len(counters) > 1:
+        stats["segments"] = len(counters)
     stats["wall_time"] = time.perf_counter() - start
     ends = Trajectory(
         np.concatenate([first.t, last.t]),

@@ -35,6 +35,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from ..errors import InvalidInputError, OutputError
+from .formats import file_format, is_zarr_store
 
 __all__ = [
     "OutputError",
@@ -79,8 +80,6 @@ REPLACES: dict[str, tuple[str, ...]] = {
 #: the kinds of folder written (a trailing slash is fine in their names)
 _FOLDER_KINDS = ("trajectory-store", "sweep-store", "cases")
 
-_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
-_CDF_SIGNATURES = (b"CDF\x01", b"CDF\x02", b"CDF\x05")
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 _GIF_SIGNATURES = (b"GIF87a", b"GIF89a")
 _HEAD = 4096  # bytes read to recognize a file
@@ -125,9 +124,9 @@ def file_kind(path: str | os.PathLike[str]) -> str | None:
     if not p.exists():
         return None
     if p.is_dir():
-        meta = p / "zarr.json" if (p / "zarr.json").exists() else (p / ".zattrs" if (p / ".zattrs").exists() else None)
-        if meta is None and not (p / ".zgroup").exists():
+        if not is_zarr_store(p):
             return "folder"
+        meta = p / "zarr.json" if (p / "zarr.json").exists() else (p / ".zattrs" if (p / ".zattrs").exists() else None)
         attrs: dict = {}
         try:
             if meta is not None:  # a v2 group without attributes has none
@@ -141,14 +140,7 @@ def file_kind(path: str | os.PathLike[str]) -> str | None:
         if "eulerpoisson_format_version" in attrs:
             return "trajectory-store"
         return "zarr"
-    try:
-        with open(p, "rb") as fh:
-            head = fh.read(8)
-    except OSError:
-        return "file"
-    if head.startswith(_HDF5_SIGNATURE) or head[:4] in _CDF_SIGNATURES:
-        return "netcdf"
-    return "file"
+    return "netcdf" if file_format(p) in ("netcdf4", "netcdf3") else "file"
 
 
 def _same_file(a, b) -> bool:

@@ -39,6 +39,11 @@ from numpy.typing import ArrayLike, NDArray
 from ..attitude.core import matrix_from_unit_quaternion
 from ..errors import InvalidInputError
 
+# the readings of a run's numbers, one list with the observations that ``fit`` reads: quaternion component orders
+# accepted by the flags (the column names may give any permutation), and what the quaternion rotates (body to
+# space, x_space = R x_body, eulerpoisson's; or space to body)
+from ..io.observations import ATTITUDE_CONVENTIONS, QUATERNION_ORDERS
+
 __all__ = [
     "Conventions",
     "RawRun",
@@ -52,12 +57,8 @@ __all__ = [
     "CSV_HEADER",
 ]
 
-#: quaternion component orders accepted by the flags (the column names may give any permutation)
-QUATERNION_ORDERS = ("wxyz", "xyzw")
 #: frames of the angular velocity
 OMEGA_FRAMES = ("body", "space")
-#: what the quaternion rotates: body to space (x_space = R x_body, eulerpoisson's) or space to body
-ATTITUDE_CONVENTIONS = ("body-to-space", "space-to-body")
 #: a quaternion whose norm differs from 1 by more than this is refused (a run's quaternions are rotations)
 NORM_TOLERANCE = 1e-3
 #: the header of a run in eulerpoisson's conventions

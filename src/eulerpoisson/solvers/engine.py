@@ -55,7 +55,7 @@ import numbers
 import time as _time
 import warnings
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
@@ -442,7 +442,6 @@ class SolveRun:
     closed_form: bool
     bounds: list[tuple[int, int]]
     workers: int | None = None
-    stats: dict = field(default_factory=dict)
 
     @property
     def options(self) -> dict[str, Any]:
@@ -460,17 +459,19 @@ class SolveRun:
         self,
         i: int,
         state: tuple[float, NDArray[np.float64], NDArray[np.float64]] | None = None,
+        tc: NDArray[np.float64] | None = None,
     ) -> Segment:
         """Segment ``i``: from the initial state (``state`` None) or continued from ``(t, q, omega)``.
 
         ``state`` is the last state of the previous segment: a stepping method continues from it, and the
         quaternion signs are made continuous with it (a closed-form method evaluates the segment from the
-        initial state).
+        initial state). ``tc``: the segment's output times when already read.
         """
         from ..util.jit import run_shape, whole_run
 
         a, b = self.bounds[i]
-        tc = read_times(self.times, a, b)
+        if tc is None:
+            tc = read_times(self.times, a, b)
         start = _time.perf_counter()
         # one choice of compiled kernels or NumPy for the whole run (the same numbers as one call; a run that is
         # itself part of a larger one keeps the larger one's size)
@@ -523,9 +524,11 @@ class SolveRun:
             )
         direction = 0
         for i in range(first, len(self.bounds)):
+            a, b = self.bounds[i]
+            tc = read_times(self.times, a, b)
             if not self.closed_form and len(self.bounds) > 1:
-                direction = _check_monotonic(self, i, state, direction)
-            seg = self.solve_segment(i, state)
+                direction = _check_monotonic(tc, a, state, direction)
+            seg = self.solve_segment(i, state, tc)
             tr = seg.trajectory
             if tr.t.size:
                 state = state_of(tr)
@@ -538,9 +541,14 @@ def _with_times(problem: Problem, t: NDArray[np.float64]) -> Problem:
     return dataclasses.replace(problem, t=t)
 
 
-def _check_monotonic(run: SolveRun, i: int, state, direction: int) -> int:
-    a, b = run.bounds[i]
-    tc = read_times(run.times, a, b)
+def _check_monotonic(tc: NDArray[np.float64], a: int, state, direction: int) -> int:
+    """The direction of time (+1 or -1) of the times ``tc`` that start at index ``a``, continuing ``state``.
+
+    Raises
+    ------
+    InvalidInputError
+        The times are not strictly monotonic in that direction.
+    """
     full = tc if state is None else np.concatenate([[state[0]], tc])
     if full.size < 2:
         return direction
@@ -798,10 +806,11 @@ def state_of(tr: Trajectory) -> tuple[float, NDArray[np.float64], NDArray[np.flo
 def evaluate(tr: Trajectory, t: ArrayLike, **options: Any) -> Trajectory:
     r"""A trajectory's motion at any times ``t``, from its nearest stored samples (``tr(t)``).
 
-    Every requested time is computed from the stored sample nearest to it
-    (ties: the earlier sample): the closed form evaluates the motion from
-    there (exact to round-off, the model being autonomous or shifted); a
-    stepping method integrates the short way from that sample with the
+    A closed form evaluates the motion at every requested time from one
+    stored sample (the one nearest to the middle of the times; exact to
+    round-off, the model being autonomous or shifted), in one call; a
+    stepping method integrates the short way from the stored sample nearest
+    to each time (ties: the earlier sample) with the
     trajectory's method and options, so the result has the trajectory's own
     error at the sample plus that of one short integration, and a time far
     outside the stored range is a continuation from the end sample. A
@@ -853,6 +862,10 @@ def evaluate(tr: Trajectory, t: ArrayLike, **options: Any) -> Trajectory:
     left = np.clip(pos - 1, 0, ts.size - 1)
     near = np.where(np.abs(ts[left] - times) <= np.abs(ts[pos] - times), left, pos)
     anchor = order[near]
+    if get_method(method).order is None:
+        # a closed form has no error that grows with the distance: one evaluation from one sample (the one
+        # nearest to the middle of the times) serves every time
+        anchor = np.full_like(anchor, anchor[np.argsort(times, kind="stable")[times.size // 2]])
     bshape = tr.batch_shape
     q = np.empty(bshape + (times.size, 4))
     w = np.empty(bshape + (times.size, 3))

@@ -40,13 +40,17 @@ browser:
 	    echo "installed chromium for the browser test" ) || \
 	  echo "chromium is not available: the browser test will be skipped"
 
-# MuJoCo for the oracle's engine test (tests/test_oracle_mujoco.py): installed where possible,
-# otherwise that test is skipped with its reason.
+# MuJoCo and PyBullet for the oracle's engine tests (tests/test_oracle_mujoco.py, the reduced conformance report
+# of tests/test_conformance.py): installed where possible (wheels only), otherwise those tests are skipped with their reason.
 mujoco: $(VENV)/.installed-test
 	@$(BIN)/python -c "import mujoco" >/dev/null 2>&1 || \
 	  ( timeout 300 $(BIN)/python -m pip install --quiet mujoco >/dev/null 2>&1 && \
 	    echo "installed mujoco for the oracle test" ) || \
 	  echo "mujoco is not available: the MuJoCo oracle test will be skipped"
+	@$(BIN)/python -c "import pybullet" >/dev/null 2>&1 || \
+	  ( timeout 300 $(BIN)/python -m pip install --quiet --only-binary :all: pybullet >/dev/null 2>&1 && \
+	    echo "installed pybullet for the conformance test" ) || \
+	  echo "pybullet is not available: its conformance tests will be skipped"
 
 test: $(VENV)/.installed-test browser mujoco
 	$(BIN)/python -m pytest -n $(WORKERS) -q
@@ -58,6 +62,25 @@ $(VENV)/.installed-peers: | $(VENV)/.installed-test
 
 bench: $(VENV)/.installed-test $(VENV)/.installed-peers
 	$(BIN)/python benchmarks/run.py
+
+# the conformance report (issue 23): the physics engines of the report installed from the package index where
+# they can be (best effort, like the peers of `make bench`; one that does not install is a row saying why) into
+# their own environment, out/engines-venv (some pin packages the project also uses), then
+# `eulerpoisson conformance` over all of them: the table and the figures into docs/user_guide/conformance/,
+# the cells into out/conformance-cells (a rerun skips the cells done; under 30 minutes on two cores)
+ENGINES_VENV := out/engines-venv
+CONFORMANCE_ENGINES ?= mujoco mujoco-mjx pybullet drake dartpy bsk newton sapien genesis-world
+.PHONY: conformance
+conformance: | $(BIN)/python
+	@test -x $(ENGINES_VENV)/bin/python || $(BIN)/python -m venv $(ENGINES_VENV)
+	$(ENGINES_VENV)/bin/python -m pip install --quiet -e '.[plot]'
+	@for p in $(CONFORMANCE_ENGINES); do \
+	  timeout 300 $(ENGINES_VENV)/bin/python -m pip install --quiet --only-binary :all: $$p >/dev/null 2>&1 && \
+	    echo "installed $$p for the conformance report" || \
+	    echo "$$p is not available: the report says why"; \
+	done
+	MPLBACKEND=Agg $(ENGINES_VENV)/bin/eulerpoisson conformance --jobs 2 --out docs/user_guide/conformance \
+	  --cells out/conformance-cells
 
 # the release check (issue 22): python -m build (an sdist and a wheel, LICENSE in both), the wheel installed
 # into a fresh virtual environment, away from the source tree, running eulerpoisson --version, warmup, demo

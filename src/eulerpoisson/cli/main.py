@@ -86,6 +86,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .warmup import add_commands as add_warmup_command  # warmup (issue 15, cold start)
 
     add_warmup_command(sub)
+    from .conformance import add_commands as add_conformance_command  # conformance (issue 23)
+
+    add_conformance_command(sub)
     return p
 
 

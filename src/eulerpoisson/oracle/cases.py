@@ -34,7 +34,16 @@ from .runs import CSV_HEADER
 if TYPE_CHECKING:
     from ..trajectory import Trajectory
 
-__all__ = ["ReferenceCase", "reference_cases", "reference_case", "write_cases", "CASE_NAMES"]
+__all__ = [
+    "ReferenceCase",
+    "reference_cases",
+    "reference_case",
+    "write_cases",
+    "CASE_NAMES",
+    "conformance_cases",
+    "CONFORMANCE_CASE_NAMES",
+    "CONFORMANCE_PERIODS",
+]
 
 
 @dataclass(frozen=True)
@@ -247,6 +256,117 @@ def _cases() -> list[ReferenceCase]:
 
 #: the names of the cases, in the suite's order
 CASE_NAMES = tuple(c.name for c in _cases())
+
+
+def _conformance_cases() -> list[ReferenceCase]:
+    racket = (3.0, 5.0, 8.0)
+    ident = (1.0, 0.0, 0.0, 0.0)
+    # omega0 = (0, a, e): 1 - k^2 = e^2 / (a^2 / 4 + e^2) for this racket; 1e-4 at a = 24 rad/s
+    e = 12.0 * np.sqrt(1e-4 / (1.0 - 1e-4))
+    q_tilt = tuple(np.array([np.cos(0.35), 0.6 * np.sin(0.35), -0.48 * np.sin(0.35), 0.64 * np.sin(0.35)]).tolist())
+    w_sphere = 2.0 * np.pi * np.array([1.0, 2.0, 3.0]) / np.sqrt(14.0)
+    return [
+        ReferenceCase(
+            "racket_near_separatrix",
+            "the tennis racket (I = 3, 5, 8) spun at 24 rad/s near its intermediate axis, 1 - k^2 = 1e-4: "
+            "it flips every 1.0 s",
+            racket,
+            (0.0, 24.0, float(e)),
+            ident,
+            10.0,
+            2001,
+            True,
+        ),
+        ReferenceCase(
+            "spin_largest_axis",
+            "the racket spun at 2 pi rad/s near its axis of largest moment (stable): a wobble of period 1.0 s",
+            racket,
+            (0.3, 0.3, 2.0 * np.pi),
+            ident,
+            10.0,
+            2001,
+        ),
+        ReferenceCase(
+            "spin_smallest_axis",
+            "the racket spun at 4 pi rad/s near its axis of smallest moment (stable): a wobble of period 1.0 s",
+            racket,
+            (4.0 * np.pi, 0.3, 0.3),
+            ident,
+            10.0,
+            2001,
+        ),
+        ReferenceCase(
+            "symmetric_precession",
+            "a symmetric top (I = 2, 2, 3) spun at 4 pi rad/s about its axis, tilted: Omega precesses "
+            "in the body once a second",
+            (2.0, 2.0, 3.0),
+            (1.0, 0.0, 4.0 * np.pi),
+            q_tilt,
+            10.0,
+            2001,
+        ),
+        ReferenceCase(
+            "fast_flat_spinner",
+            "a flat body (I = 1, 1.05, 2) spun at 150 rad/s about its axis of largest moment, wobbling "
+            "every 0.044 s (past the 100 rad/s some engines clamp to)",
+            (1.0, 1.05, 2.0),
+            (3.0, 0.0, 150.0),
+            ident,
+            0.5,
+            2001,
+        ),
+        ReferenceCase(
+            "nearly_spherical",
+            "a nearly spherical body (I = 1, 1.02, 1.04) turning once a second (|Omega| = 2 pi rad/s), tilted",
+            (1.0, 1.02, 1.04),
+            tuple(float(x) for x in w_sphere),
+            q_tilt,
+            10.0,
+            2001,
+        ),
+        ReferenceCase(
+            "full_tensor_tilted",
+            "a full inertia tensor whose principal axes are not the body axes, tilted, |Omega| = 25 rad/s: "
+            "Omega(t) has a period of 1.0 s",
+            ((2.0, 0.1, 0.0), (0.1, 1.5, -0.2), (0.0, -0.2, 1.2)),
+            (7.44, -11.69, 21.26),
+            q_tilt,
+            10.0,
+            2001,
+        ),
+    ]
+
+
+#: the cases of the conformance report (:mod:`eulerpoisson.oracle.conformance`), each with periods near 1 s
+CONFORMANCE_CASE_NAMES = tuple(c.name for c in _conformance_cases())
+#: what a case's natural period is: ``"flip"`` (2K/lambda, between flips), ``"momentum"`` (4K/lambda, of
+#: Omega(t)), ``"precession"`` (of Omega about the symmetry axis, in the body) or ``"rotation"`` (2 pi/|Omega|)
+CONFORMANCE_PERIODS = {
+    "racket_near_separatrix": "flip",
+    "spin_largest_axis": "momentum",
+    "spin_smallest_axis": "momentum",
+    "symmetric_precession": "precession",
+    "fast_flat_spinner": "momentum",
+    "nearly_spherical": "rotation",
+    "full_tensor_tilted": "momentum",
+}
+
+
+def conformance_cases() -> dict[str, ReferenceCase]:
+    """The cases of the conformance report, by name (new objects at every call).
+
+    Returns
+    -------
+    dict of str to ReferenceCase
+
+    Examples
+    --------
+    >>> from eulerpoisson.oracle.cases import conformance_cases
+    >>> cases = conformance_cases()
+    >>> len(cases), cases["racket_near_separatrix"].omega0[:2]
+    (7, (0.0, 24.0))
+    """
+    return {c.name: c for c in _conformance_cases()}
 
 
 def reference_cases() -> dict[str, ReferenceCase]:

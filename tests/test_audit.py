@@ -1,6 +1,7 @@
 """Tests of the paper audit (eulerpoisson.paper.audit).
 
-The whole audit runs once (module fixture).  Verdicts are computed, so the
+The whole audit runs once per test run (conftest's audit_report_once, which
+the README's examples share).  Verdicts are computed, so the
 tests check them against hand analysis of the paper, and check that they
 *follow the computation*: perturbing a transcription flips a confirmed entry
 to misprint, and substituting the correction flips a misprint to confirmed.
@@ -34,8 +35,9 @@ PAPER_CANDIDATES = [
 
 
 @pytest.fixture(scope="module")
-def report():
-    return A.run_audit()
+def report(audit_report_once):
+    """``A.run_audit()``: computed once per test run (conftest), shared with the README's examples."""
+    return audit_report_once()
 
 
 def _spec(equation):

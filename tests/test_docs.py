@@ -21,7 +21,8 @@ def test_the_readme_has_python_examples():
 
 
 @pytest.mark.parametrize("index", range(len(BLOCKS)))
-def test_readme_python_block_runs(index, tmp_path, monkeypatch, capsys):
+def test_readme_python_block_runs(index, tmp_path, monkeypatch, capsys, shared_audit):
+    # run_audit() gives the run's one audit report (computed once, checked in test_audit.py; conftest)
     monkeypatch.chdir(tmp_path)
     # the later blocks use the names of the first one (the short tour), as in one session
     namespace: dict = {}

@@ -25,6 +25,10 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 # keep matplotlib off any display
 os.environ.setdefault("MPLBACKEND", "Agg")
+# the JAX tests (eulerpoisson.jax) compile large programs (the closed form and its derivatives): XLA's
+# optimizing passes take most of that time (2.5x less without them, the same values: they only fuse and
+# schedule); set before jax is imported
+os.environ.setdefault("JAX_DISABLE_MOST_OPTIMIZATIONS", "1")
 
 
 @pytest.fixture

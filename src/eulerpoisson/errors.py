@@ -204,3 +204,19 @@ class PoorFitError(FitInputError):
     def __init__(self, message: str, result=None):
         super().__init__(message)
         self.result = result
+
+
+class PrecisionError(EulerPoissonError, TypeError):
+    """A JAX function of :mod:`eulerpoisson.jax` was traced without 64-bit floats and no ``dtype`` was chosen.
+
+    The functions of :mod:`eulerpoisson.jax` compute in float64 by default. Called eagerly they
+    enable 64-bit floats for themselves; inside a user's ``jit``/``grad``/``vmap`` they cannot, and
+    say how: ``jax.config.update("jax_enable_x64", True)`` (or ``with jax.enable_x64(True):``), or
+    ``dtype=jnp.float32`` for single precision.
+
+    Examples
+    --------
+    >>> from eulerpoisson.errors import PrecisionError
+    >>> issubclass(PrecisionError, TypeError)
+    True
+    """

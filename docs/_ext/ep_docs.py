@@ -149,7 +149,7 @@ def write_api_pages(modules, srcdir: Path = DOCS) -> None:
 # ---------------------------------------------------------------------------
 
 #: examples that need an optional peer: shown, run only where the peer imports
-OPTIONAL_PEERS = {"validate_mujoco.py": "mujoco"}
+OPTIONAL_PEERS = {"validate_mujoco.py": "mujoco", "jax_fit.py": "jax"}
 
 
 def executable_pattern() -> str:

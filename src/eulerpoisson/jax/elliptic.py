@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import functools
 import math
+import os
 from typing import NamedTuple
 
 import jax
@@ -90,6 +91,26 @@ LANDEN_LEVELS = 4
 
 _SIN_C = tuple((-1) ** k / math.factorial(2 * k + 1) for k in range(1, 9))
 _COS_C = tuple((-1) ** k / math.factorial(2 * k) for k in range(2, 10))
+
+
+def fused_loops() -> bool:
+    """Whether the loops are unrolled and the batch-wide skips (``lax.cond``) replaced by masked steps.
+
+    On a GPU one fused kernel per evaluation is much faster than a kernel per loop iteration (the
+    state of every iteration would go through memory); on the CPU the rolled loops with skips compile
+    faster and run as fast. The values are the same either way. Default: fused on any backend but
+    the CPU; ``EULERPOISSON_JAX_FUSED=1`` or ``0`` forces the choice (read when a function is traced).
+
+    Examples
+    --------
+    >>> from eulerpoisson.jax.elliptic import fused_loops
+    >>> isinstance(fused_loops(), bool)
+    True
+    """
+    forced = os.environ.get("EULERPOISSON_JAX_FUSED", "")
+    if forced in ("0", "1"):
+        return forced == "1"
+    return jax.default_backend() != "cpu"
 
 
 class Consts(NamedTuple):
@@ -211,7 +232,7 @@ def ellipk_dd(m1):
             jnp.where(act, nbl, straight(bl, nbl)),
         )
 
-    ah, al, bh, bl = jax.lax.fori_loop(0, C.agm_steps, step, (ah, al, bh, bl))
+    ah, al, bh, bl = jax.lax.fori_loop(0, C.agm_steps, step, (ah, al, bh, bl), unroll=fused_loops())
     kh, kl = dd_div(jnp.full_like(ah, C.pi_hi), jnp.full_like(ah, C.pi_lo), ah, al)
     kh, kl = 0.5 * kh, 0.5 * kl
     return jnp.where(sep, jnp.inf, kh), jnp.where(sep, 0.0, kl)
@@ -335,7 +356,9 @@ def _sncndn_real(vn, dv, P: JacobiParams):
             jnp.where(use, y_new, straight(y, y_new)),
         )
 
-    s, c, y = jax.lax.fori_loop(0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(s, c, y, P.m)[:3]))
+    s, c, y = jax.lax.fori_loop(
+        0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(s, c, y, P.m)[:3]), unroll=fused_loops()
+    )
     c = jnp.where(y < 0.5, 1.0 - y, c)
     return s, c
 
@@ -358,7 +381,9 @@ def _sncndn_imag(vn, dv, P: JacobiParams):
         C_new = Cc * D / den
         return jnp.where(use, sig_new, straight(sig, sig_new)), jnp.where(use, C_new, straight(Cc, C_new))
 
-    sig, Cc = jax.lax.fori_loop(0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(sig, Cc, P.m)[:2]))
+    sig, Cc = jax.lax.fori_loop(
+        0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(sig, Cc, P.m)[:2]), unroll=fused_loops()
+    )
     return sig / Cc, 1.0 / Cc
 
 
@@ -454,7 +479,7 @@ def rf(x, y, z):
         new = (0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam))
         return tuple(jnp.where(act, nv, ov) for nv, ov in zip(new, st))
 
-    a, fac, *_ = jax.lax.fori_loop(0, C.rf_steps, step, (a0, jnp.ones_like(a0), x, y, z))
+    a, fac, *_ = jax.lax.fori_loop(0, C.rf_steps, step, (a0, jnp.ones_like(a0), x, y, z), unroll=fused_loops())
     X = (a0 - x) * fac / a
     Y = (a0 - y) * fac / a
     Z = -(X + Y)
@@ -505,7 +530,10 @@ def _rj_step(act, st, C: Consts, delta, sc):
     y1 = 2.0 * sp * (p + lam) / d
     # the closed forms (atan, log1p: the costly part) only when an element needs them
     big = jnp.any(act & (jnp.abs(e) > C.rc_series))
-    rc = jax.lax.cond(big, functools.partial(_rc1, C=C), lambda e, y1: _rc1_series(e), e, y1)
+    if fused_loops():
+        rc = _rc1(e, y1, C=C)
+    else:
+        rc = jax.lax.cond(big, functools.partial(_rc1, C=C), lambda e, y1: _rc1_series(e), e, y1)
     new = (
         0.25 * (a + lam),
         0.25 * fac,
@@ -536,9 +564,11 @@ def rj(x, y, z, p):
         # a step that no element needs is skipped (a branch on the whole batch: the values are those
         # of the elementwise stop; under vmap both branches run, with the same values)
         act = st[1] * q >= jnp.abs(st[0])
+        if fused_loops():
+            return _rj_step(act, st, C=C, delta=delta, sc=sc)
         return jax.lax.cond(jnp.any(act), functools.partial(_rj_step, C=C, delta=delta, sc=sc), _keep, act, st)
 
-    st = jax.lax.fori_loop(0, C.rj_steps, body, st)
+    st = jax.lax.fori_loop(0, C.rj_steps, body, st, unroll=fused_loops())
     a, fac, _, _, _, _, acc = st
     X = (a0 - x) * fac / a
     Y = (a0 - y) * fac / a

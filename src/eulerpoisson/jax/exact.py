@@ -26,6 +26,7 @@ References
 
 from __future__ import annotations
 
+import functools
 from typing import NamedTuple
 
 import jax
@@ -471,7 +472,8 @@ def _principal_motion(inertia, M0, t):
 @jax.custom_jvp
 def _eigh(a):
     """``jnp.linalg.eigh`` whose derivative is finite at repeated eigenvalues (see :func:`exact_motion`)."""
-    return jnp.linalg.eigh(a, symmetrize_input=False)
+    w, v = jnp.linalg.eigh(a, symmetrize_input=False)
+    return w, v  # a plain pair (the JVP rule returns one; eigh's own result type differs across jax versions)
 
 
 @_eigh.defjvp
@@ -687,6 +689,13 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
             f"of t {t.shape} do not broadcast"
         ) from exc
     _check_inputs(inertia, q0, w0, t, tensor)
+    return _motion(inertia, q0, w0, t, tensor=tensor, shape=tuple(shape))
+
+
+@functools.partial(jax.jit, static_argnames=("tensor", "shape"))
+def _motion(inertia, q0, w0, t, *, tensor, shape):
+    """The computation of :func:`exact_motion` after the checks, compiled once per shape and dtype (an eager
+    call then costs one dispatch, not one per operation; inside a user's ``jit`` it is inlined)."""
     q0 = q0 / jnp.sqrt(jnp.sum(q0 * q0, axis=-1, keepdims=True))
     if tensor:
         A = 0.5 * (inertia + jnp.swapaxes(inertia, -1, -2))

@@ -86,6 +86,12 @@ __all__ = [
     "elliprj",
 ]
 
+#: duplication steps of the public elliprj: traced, then tried in turn on concrete arguments
+_RJ_PUBLIC_STEPS = (40, 120, 480)
+
+#: batches at least this large take the short R_J loop in the fused form (see :func:`rj`)
+_SHORT_MIN = 1024
+
 #: the number of Landen levels (at most 4 are used in float64, 3 in float32)
 LANDEN_LEVELS = 4
 
@@ -133,6 +139,8 @@ class Consts(NamedTuple):
     rc_series: float  # R_C(1, 1 + e) by its series for |e| <= rc_series
     delta_tiny: float  # R_J's (p-x)(p-y)(p-z) is rescaled below this
     eps: float
+    rj_closed: int  # the short R_J loop: steps with R_C's closed forms ...
+    rj_short: int  # ... and steps in all (see rj)
 
 
 def _split_const(x: float, dtype) -> tuple[float, float]:
@@ -174,6 +182,8 @@ def consts(dtype) -> Consts:
             2.0**-5,
             2.0**-960,
             2.0**-52,
+            2,
+            9,
         )
     tol = 2.0**-24
     # pi and pi/2 as float-float numbers (the low parts from the float64 value, enough in float32)
@@ -197,6 +207,8 @@ def consts(dtype) -> Consts:
         2.0**-5,
         2.0**-100,
         2.0**-23,
+        2,
+        6,
     )
 
 
@@ -232,7 +244,7 @@ def ellipk_dd(m1):
             jnp.where(act, nbl, straight(bl, nbl)),
         )
 
-    ah, al, bh, bl = jax.lax.fori_loop(0, C.agm_steps, step, (ah, al, bh, bl), unroll=fused_loops())
+    ah, al, bh, bl = _loop(C.agm_steps, step, (ah, al, bh, bl))
     kh, kl = dd_div(jnp.full_like(ah, C.pi_hi), jnp.full_like(ah, C.pi_lo), ah, al)
     kh, kl = 0.5 * kh, 0.5 * kl
     return jnp.where(sep, jnp.inf, kh), jnp.where(sep, 0.0, kl)
@@ -325,8 +337,19 @@ def _cos_poly(x):
 
 
 def _level(levels, i):
-    """Level ``i`` (traced index) of a stack of Landen levels."""
+    """Level ``i`` (a Python int in the fused form, else a traced index) of a stack of Landen levels."""
+    if isinstance(i, int):
+        return levels[i]
     return jax.lax.dynamic_index_in_dim(levels, i, axis=0, keepdims=False)
+
+
+def _loop(steps, body, state):
+    """``lax.fori_loop(0, steps, body, state)``; in the fused form a Python loop (static indices)."""
+    if fused_loops():
+        for k in range(steps):
+            state = body(k, state)
+        return state
+    return jax.lax.fori_loop(0, steps, body, state)
 
 
 def _sncndn_real(vn, dv, P: JacobiParams):
@@ -356,9 +379,7 @@ def _sncndn_real(vn, dv, P: JacobiParams):
             jnp.where(use, y_new, straight(y, y_new)),
         )
 
-    s, c, y = jax.lax.fori_loop(
-        0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(s, c, y, P.m)[:3]), unroll=fused_loops()
-    )
+    s, c, y = _loop(LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(s, c, y, P.m)[:3]))
     c = jnp.where(y < 0.5, 1.0 - y, c)
     return s, c
 
@@ -381,9 +402,7 @@ def _sncndn_imag(vn, dv, P: JacobiParams):
         C_new = Cc * D / den
         return jnp.where(use, sig_new, straight(sig, sig_new)), jnp.where(use, C_new, straight(Cc, C_new))
 
-    sig, Cc = jax.lax.fori_loop(
-        0, LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(sig, Cc, P.m)[:2]), unroll=fused_loops()
-    )
+    sig, Cc = _loop(LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(sig, Cc, P.m)[:2]))
     return sig / Cc, 1.0 / Cc
 
 
@@ -479,7 +498,7 @@ def rf(x, y, z):
         new = (0.25 * (a + lam), 0.25 * fac, 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam))
         return tuple(jnp.where(act, nv, ov) for nv, ov in zip(new, st))
 
-    a, fac, *_ = jax.lax.fori_loop(0, C.rf_steps, step, (a0, jnp.ones_like(a0), x, y, z), unroll=fused_loops())
+    a, fac, *_ = _loop(C.rf_steps, step, (a0, jnp.ones_like(a0), x, y, z))
     X = (a0 - x) * fac / a
     Y = (a0 - y) * fac / a
     Z = -(X + Y)
@@ -519,8 +538,11 @@ def _keep(act, st):
     return st
 
 
-def _rj_step(act, st, C: Consts, delta, sc):
-    """One duplication step of ``R_J`` on the elements ``act``."""
+def _rj_step(act, st, C: Consts, delta, sc, closed=True):
+    """One duplication step of ``R_J`` on the elements ``act`` (and ``e``, the argument of its ``R_C``).
+
+    ``closed=False``: ``R_C`` by its series alone (right where ``|e| <= 2**-5``; see :func:`rj`).
+    """
     a, fac, x, y, z, p, acc = st
     sx, sy, sz, sp = safe_sqrt(x), safe_sqrt(y), safe_sqrt(z), safe_sqrt(p)
     lam = sx * sy + sy * sz + sz * sx
@@ -529,10 +551,12 @@ def _rj_step(act, st, C: Consts, delta, sc):
     e = (fac * fac * fac) * delta / (dd * dd)
     y1 = 2.0 * sp * (p + lam) / d
     # the closed forms (atan, log1p: the costly part) only when an element needs them
-    big = jnp.any(act & (jnp.abs(e) > C.rc_series))
-    if fused_loops():
+    if not closed:
+        rc = _rc1_series(e)
+    elif fused_loops():
         rc = _rc1(e, y1, C=C)
     else:
+        big = jnp.any(act & (jnp.abs(e) > C.rc_series))
         rc = jax.lax.cond(big, functools.partial(_rc1, C=C), lambda e, y1: _rc1_series(e), e, y1)
     new = (
         0.25 * (a + lam),
@@ -543,13 +567,10 @@ def _rj_step(act, st, C: Consts, delta, sc):
         0.25 * (p + lam),
         acc + fac * rc / d,
     )
-    return tuple(jnp.where(act, nv, ov) for nv, ov in zip(new, st))
+    return tuple(jnp.where(act, nv, ov) for nv, ov in zip(new, st)), e
 
 
-def rj(x, y, z, p):
-    """Carlson's ``R_J`` for ``x, y, z >= 0`` (at most one zero), ``p > 0`` (no checks)."""
-    C = _c(x)
-    x, y, z, p = jnp.broadcast_arrays(x, y, z, p)
+def _rj_start(x, y, z, p, C: Consts):
     a0 = (x + y + z + 2.0 * p) / 5.0
     delta, sc = _rj_delta(x, y, z, p, C)
     q = C.rj_q * jnp.maximum(
@@ -557,18 +578,10 @@ def rj(x, y, z, p):
         jnp.maximum(jnp.abs(a0 - z), jnp.abs(a0 - p)),
     )
     q = jax.lax.stop_gradient(q)
+    return (a0, jnp.ones_like(a0), x, y, z, p, jnp.zeros_like(a0)), delta, sc, q
 
-    st = (a0, jnp.ones_like(a0), x, y, z, p, jnp.zeros_like(a0))
 
-    def body(_, st):
-        # a step that no element needs is skipped (a branch on the whole batch: the values are those
-        # of the elementwise stop; under vmap both branches run, with the same values)
-        act = st[1] * q >= jnp.abs(st[0])
-        if fused_loops():
-            return _rj_step(act, st, C=C, delta=delta, sc=sc)
-        return jax.lax.cond(jnp.any(act), functools.partial(_rj_step, C=C, delta=delta, sc=sc), _keep, act, st)
-
-    st = jax.lax.fori_loop(0, C.rj_steps, body, st, unroll=fused_loops())
+def _rj_end(x, y, z, a0, st):
     a, fac, _, _, _, _, acc = st
     X = (a0 - x) * fac / a
     Y = (a0 - y) * fac / a
@@ -590,6 +603,81 @@ def rj(x, y, z, p):
         + 3.0 * e5 / 26.0
     )
     return fac * poly / (a * jnp.sqrt(a)) + 6.0 * acc
+
+
+def _rj_all(x, y, z, p, C: Consts, steps=None, converged=False):
+    """``R_J`` by the full loop: ``C.rj_steps`` (or ``steps``) steps, each with the closed forms of ``R_C`` where
+    needed; with ``converged``, also whether the steps sufficed (enough for the closed form's arguments, not for
+    every argument: ``p`` far above ``x, y, z`` falls only 4-fold per step)."""
+    st, delta, sc, q = _rj_start(x, y, z, p, C)
+
+    def body(_, st):
+        # a step that no element needs is skipped (a branch on the whole batch: the values are those
+        # of the elementwise stop; under vmap both branches run, with the same values)
+        act = st[1] * q >= jnp.abs(st[0])
+        if fused_loops():
+            return _rj_step(act, st, C=C, delta=delta, sc=sc)[0]
+        step = functools.partial(_rj_step, C=C, delta=delta, sc=sc)
+        return jax.lax.cond(jnp.any(act), lambda act, st: step(act, st)[0], _keep, act, st)
+
+    st = _loop(C.rj_steps if steps is None else steps, body, st)
+    value = _rj_end(x, y, z, _rj_a0(x, y, z, p), st)
+    if converged:
+        return value, st[1] * q < jnp.abs(st[0])
+    return value
+
+
+def _rj_a0(x, y, z, p):
+    return (x + y + z + 2.0 * p) / 5.0
+
+
+def _rj_short(x, y, z, p, C: Consts):
+    """The common case in fewer operations: ``(value, redo)``.
+
+    ``C.rj_closed`` steps with the closed forms of ``R_C``, then series-only steps up to
+    ``C.rj_short`` in all. Where neither sufficed (``redo``: a later step with ``|e| > 2**-5``, or
+    not converged), the value is wrong and the element must be recomputed by :func:`_rj_all`;
+    elsewhere it is the value of :func:`_rj_all`, bit for bit (the same operations).
+    """
+    st, delta, sc, q = _rj_start(x, y, z, p, C)
+    redo = jnp.zeros(x.shape, bool)
+    for k in range(C.rj_short):
+        act = st[1] * q >= jnp.abs(st[0])
+        st, e = _rj_step(act, st, C=C, delta=delta, sc=sc, closed=k < C.rj_closed)
+        if k >= C.rj_closed:
+            redo = redo | (act & (jnp.abs(e) > C.rc_series))
+    redo = redo | (st[1] * q >= jnp.abs(st[0]))
+    return _rj_end(x, y, z, _rj_a0(x, y, z, p), st), redo
+
+
+def rj(x, y, z, p):
+    """Carlson's ``R_J`` for ``x, y, z >= 0`` (at most one zero), ``p > 0`` (no checks).
+
+    In the fused form (GPUs) a large batch takes the short loop of :func:`_rj_short` (``R_J``'s
+    duplication shrinks the argument ``e`` of its ``R_C`` terms 64-fold per step: the closed forms
+    matter in the first steps only, and 8 steps suffice for almost every argument) and recomputes the
+    few elements that need more with the full loop (gathered into a buffer of 1/16 of the batch; the
+    whole batch again if they do not fit). Which loop gives an element's value depends on that
+    element alone, never on the rest of the batch (the two agree to an ulp or two: XLA contracts
+    multiply-adds by context).
+    """
+    C = _c(x)
+    x, y, z, p = jnp.broadcast_arrays(x, y, z, p)
+    n = math.prod(x.shape)
+    if not fused_loops() or n < _SHORT_MIN:
+        return _rj_all(x, y, z, p, C)
+    val, redo = _rj_short(x, y, z, p, C)
+    shape = x.shape
+    flat = [a.reshape(-1) for a in (x, y, z, p, val)]
+    redo = redo.reshape(-1)
+    nbuf = max(_SHORT_MIN // 16, n // 16)
+    (idx,) = jnp.nonzero(redo, size=nbuf, fill_value=n)
+    xs, ys, zs, ps = (a.at[idx].get(mode="clip") for a in flat[:4])
+    patched = flat[4].at[idx].set(_rj_all(xs, ys, zs, ps, C), mode="drop")
+    count = jnp.sum(redo)
+    xf, yf, zf, pf = flat[:4]
+    res = jax.lax.cond(count > nbuf, lambda: jnp.where(redo, _rj_all(xf, yf, zf, pf, C), flat[4]), lambda: patched)
+    return res.reshape(shape)
 
 
 # ---------------------------------------------------------------------------
@@ -751,11 +839,15 @@ def elliprj(x, y, z, p, *, dtype=None):
     Returns
     -------
     jax.Array
+        ``R_J``. Concrete arguments take as many duplication steps as they need (up to 480); traced
+        ones (under ``jit``/``grad``) a fixed 40, enough unless ``p`` exceeds ``max(x, y, z)`` by about
+        ``1e16``: NaN there, never a wrong number.
 
     Raises
     ------
     InvalidInputError
-        On negative or non-finite (concrete) arguments, ``p <= 0`` or two zeros among ``x, y, z``.
+        On negative or non-finite (concrete) arguments, ``p <= 0`` or two zeros among ``x, y, z``; when
+        480 steps do not converge (``p`` above ``max(x, y, z)`` by more than about ``1e280``).
 
     Examples
     --------
@@ -764,6 +856,19 @@ def elliprj(x, y, z, p, *, dtype=None):
     1.0
     """
     x, y, z, p = _carlson_args(("x", "y", "z", "p"), (x, y, z, p), dtype)
-    if _concrete(p):
-        _check(p > 0.0, f"p must be > 0 (no principal values), got {p}")
-    return rj(x, y, z, p)
+    x, y, z, p = jnp.broadcast_arrays(x, y, z, p)
+    C = _c(x)
+    if not _concrete(x, y, z, p):
+        # traced: a fixed number of steps; NaN where they do not suffice (p above x, y, z by more than ~1e6)
+        value, ok = _rj_all(x, y, z, p, C, steps=_RJ_PUBLIC_STEPS[0], converged=True)
+        return jnp.where(ok, value, jnp.nan)
+    _check(p > 0.0, f"p must be > 0 (no principal values), got {p}")
+    for steps in _RJ_PUBLIC_STEPS:
+        value, ok = _rj_all(x, y, z, p, C, steps=steps, converged=True)
+        if bool(jnp.all(ok)):
+            return value
+    raise InvalidInputError(
+        "elliprj: the arguments are too far apart for the duplication to converge "
+        f"(p / max(x, y, z) up to {float(jnp.max(p / jnp.maximum(jnp.maximum(x, y), z))):.3g}; "
+        f"{_RJ_PUBLIC_STEPS[-1]} steps)"
+    )

@@ -616,7 +616,9 @@ def _heavy_top(A, C, P, q0, om, t, t_scale=None, t_times=None, post=None, compil
         qf, q0_in, om_in = (np.ascontiguousarray(x[i], dtype=np.float64) for x in post)
         bad = 0
         if T:
-            bad = _LK.heavy_top_kernel(Cb, np.ascontiguousarray(t_times, dtype=np.float64), qf, q0_in, om_in, q, o)
+            # (writeable: the times may be a read-only array, another signature of the kernel; a copy then only)
+            tk = np.require(t_times, dtype=np.float64, requirements=("C", "A", "W", "E"))
+            bad = _LK.heavy_top_kernel(Cb, tk, qf, q0_in, om_in, q, o)
         if bad == 0:
             if not every:
                 q_out[i] = q

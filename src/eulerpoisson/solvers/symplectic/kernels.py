@@ -668,9 +668,18 @@ if USE_NUMBA:  # pragma: no branch
 # ---------------------------------------------------------------------------
 # entry points
 # ---------------------------------------------------------------------------
+def _kernel_array(x):
+    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
+
+    numba compiles one specialization per array type, and a read-only array
+    (``np.broadcast_to``, ``flags.writeable = False``) is a type of its own.
+    """
+    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
+
+
 def sincos_compiled(x):
     """:math:`(\\sin x, \\cos x)` by the compiled kernel (float64, 1-D); for tests."""
-    x = np.ascontiguousarray(x, dtype=np.float64).ravel()
+    x = _kernel_array(np.ravel(x))
     s = np.empty_like(x)
     c = np.empty_like(x)
     _nb_sincos_array(x, s, c)
@@ -707,9 +716,9 @@ def run_splitting(q0, M0, inv_m, sequence, t, dt):
     q_out = np.empty((B, T, 4))
     w_out = np.empty((B, T, 3))
     nb_splitting(
-        np.ascontiguousarray(q0, dtype=np.float64),
-        np.ascontiguousarray(M0, dtype=np.float64),
-        np.ascontiguousarray(inv_m, dtype=np.float64),
+        _kernel_array(q0),
+        _kernel_array(M0),
+        _kernel_array(inv_m),
         axes,
         fracs,
         h,
@@ -758,8 +767,8 @@ def run_gauss_quaternion(y0, inv_m, tableau, t, dt, max_iter):
     iters = np.zeros((B, 2), dtype=np.int64)
     status = np.zeros(4)
     nb_gauss(
-        np.ascontiguousarray(y0, dtype=np.float64),
-        np.ascontiguousarray(inv_m, dtype=np.float64),
+        _kernel_array(y0),
+        _kernel_array(inv_m),
         A,
         b,
         E,

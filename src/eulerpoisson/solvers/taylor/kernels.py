@@ -1204,17 +1204,23 @@ if USE_NUMBA:  # pragma: no branch
     nb_integrate_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(nb_integrate_lanes)
 
 
+def _kernel_array(x):
+    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
+
+    numba compiles one specialization per array type, and a read-only array
+    (``np.broadcast_to``, ``flags.writeable = False``, a NetCDF read) is a
+    type of its own: every array passed to the kernels goes through here, so
+    that each kernel has one signature (the one ``eulerpoisson warmup`` compiles).
+    """
+    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
+
+
 def coefficients_numba(moments, n0, w0, order):
     """Taylor coefficients by the compiled kernel, (B, order+1, 3) each (float64).
 
     Runs the plain-Python version of the same code when numba is not used.
     """
-    return _nb_coefficients(
-        np.ascontiguousarray(moments, dtype=np.float64),
-        np.ascontiguousarray(n0, dtype=np.float64),
-        np.ascontiguousarray(w0, dtype=np.float64),
-        int(order),
-    )
+    return _nb_coefficients(_kernel_array(moments), _kernel_array(n0), _kernel_array(w0), int(order))
 
 
 def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold, lanes=None):
@@ -1229,10 +1235,7 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     Runs the plain-Python version of the same code when numba is not used
     (slow; :func:`integrate_numpy` is the fallback actually used then).
     """
-    moments = np.ascontiguousarray(moments, dtype=np.float64)
-    w0 = np.ascontiguousarray(w0, dtype=np.float64)
-    qref0 = np.ascontiguousarray(qref0, dtype=np.float64)
-    t = np.ascontiguousarray(t, dtype=np.float64)
+    moments, w0, qref0, t = (_kernel_array(x) for x in (moments, w0, qref0, t))  # (one signature per kernel)
     B, T = moments.shape[0], t.shape[0]
     pos = np.flatnonzero(t >= 0)
     pos = np.ascontiguousarray(pos[np.argsort(t[pos], kind="stable")], dtype=np.int64)

@@ -469,6 +469,15 @@ if USE_NUMBA:  # pragma: no branch
     integrate_body = _njit(cache=True, nogil=True, fastmath={"contract"})(integrate_body)
 
 
+def _kernel_array(x):
+    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
+
+    numba compiles one specialization per array type, and a read-only array
+    (``np.broadcast_to``, ``flags.writeable = False``) is a type of its own.
+    """
+    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
+
+
 def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps):
     """Integrate a batch of bodies under polynomial torques.
 
@@ -496,6 +505,9 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
     status : ndarray (B,) of int
         0 ok, 1 ``max_steps`` exhausted, 2 non-finite state.
     """
+    # C-contiguous writeable float64 (a copy only where needed: the inertia is a broadcast view, read-only,
+    # and so may be the torque's arrays): one signature of integrate_body, the one the warm-up compiles
+    inertia, q0, w0, tau0, S, L = (_kernel_array(x) for x in (inertia, q0, w0, data.tau0, data.S, data.L))
     B = q0.shape[0]
     T = t.shape[0]
     qout = np.empty((B, T, 4))
@@ -503,14 +515,14 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
     status = np.zeros(B, dtype=np.int64)
     steps_total = 0
     steps_max = 0
-    Iinv = np.linalg.inv(inertia) if B else inertia
+    Iinv = _kernel_array(np.linalg.inv(inertia)) if B else inertia
     pos = np.flatnonzero(t >= 0)
     neg = np.flatnonzero(t < 0)
     branches = []
     for idx in (pos, neg):
         if idx.size:
             order_idx = idx[np.argsort(np.abs(t[idx]), kind="stable")]
-            branches.append((order_idx, np.ascontiguousarray(t[order_idx])))
+            branches.append((order_idx, _kernel_array(t[order_idx])))
     fixed = float(dt) if dt is not None else 0.0
     for b in range(B):
         used = 0
@@ -518,13 +530,13 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
             qo = np.empty((ts.shape[0], 4))
             wo = np.empty((ts.shape[0], 3))
             steps, st = integrate_body(
-                np.ascontiguousarray(q0[b]),
-                np.ascontiguousarray(w0[b]),
-                np.ascontiguousarray(inertia[b]),
-                np.ascontiguousarray(Iinv[b]),
-                data.tau0[b],
-                np.ascontiguousarray(data.S[b]),
-                np.ascontiguousarray(data.L[b]),
+                q0[b],
+                w0[b],
+                inertia[b],
+                Iinv[b],
+                tau0[b],
+                S[b],
+                L[b],
                 float(data.nu[b]),
                 float(data.kappa[b]),
                 ts,

@@ -37,6 +37,7 @@ from ..errors import InvalidInertiaError, InvalidInputError
 from .doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, safe_sqrt, straight, two_prod, two_sum
 from .elliptic import JacobiParams, consts, jacobi_params, rf, rj, sncndn_dd
 from .precision import as_float, float64_by_default
+from .quaternion import qmul_components as _qmul
 
 __all__ = ["exact_motion"]
 
@@ -44,13 +45,6 @@ __all__ = ["exact_motion"]
 # ---------------------------------------------------------------------------
 # quaternions (components)
 # ---------------------------------------------------------------------------
-def _qmul(pw, px, py, pz, qw, qx, qy, qz):
-    return (
-        pw * qw - px * qx - py * qy - pz * qz,
-        pw * qx + px * qw + py * qz - pz * qy,
-        pw * qy - px * qz + py * qw + pz * qx,
-        pw * qz + px * qy - py * qx + pz * qw,
-    )
 
 
 def _qmin(M1, M2, M3, caseB, sa):

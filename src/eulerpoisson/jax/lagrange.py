@@ -40,6 +40,8 @@ from ..errors import InvalidInputError
 from .doubledouble import safe_sqrt, straight
 from .elliptic import ellipk_dd, jacobi_params, rf, rj, sncndn_dd
 from .precision import as_float, float64_by_default
+from .quaternion import qconj as _conj
+from .quaternion import qmul as _qmul
 
 __all__ = ["lagrange_top_motion"]
 
@@ -52,22 +54,6 @@ _BRACKET_ITERS = 200
 # ---------------------------------------------------------------------------
 # small helpers
 # ---------------------------------------------------------------------------
-def _qmul(p, q):
-    pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
-    qw, qx, qy, qz = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return jnp.stack(
-        [
-            pw * qw - px * qx - py * qy - pz * qz,
-            pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx,
-            pw * qz + px * qy - py * qx + pz * qw,
-        ],
-        -1,
-    )
-
-
-def _conj(q):
-    return q * jnp.asarray([1.0, -1.0, -1.0, -1.0], q.dtype)
 
 
 def _safe_div(a, b):

@@ -56,6 +56,8 @@ import jax.numpy as jnp
 
 from ..errors import InvalidInputError
 from .precision import as_float, float64_by_default
+from .quaternion import qconj as _conj
+from .quaternion import qmul as _qmul
 from .torques import from_torque
 
 __all__ = ["integrate", "SplittingResult", "composition", "ORDERS", "quaternion_from_matrix", "rk4_free_flow"]
@@ -116,24 +118,6 @@ def composition(order: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
     w1 = 1.0 / (2.0 - 2.0 ** (1.0 / 3.0))
     w0 = 1.0 - 2.0 * w1
     return (0.5 * w1, 0.5 * (w1 + w0), 0.5 * (w0 + w1), 0.5 * w1), (w1, w0, w1)
-
-
-def _qmul(p, q):
-    pw, px, py, pz = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
-    qw, qx, qy, qz = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return jnp.stack(
-        [
-            pw * qw - px * qx - py * qy - pz * qz,
-            pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx,
-            pw * qz + px * qy - py * qx + pz * qw,
-        ],
-        -1,
-    )
-
-
-def _conj(q):
-    return q * jnp.array([1.0, -1.0, -1.0, -1.0], dtype=q.dtype)
 
 
 def _normalize(q):

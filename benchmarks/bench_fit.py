@@ -90,7 +90,48 @@ def run(quick: bool = False, log=print) -> dict:
             worst_z=worst_z(res),
             observations=n,
         )
+    # a Toutatis-like case (issue 25 #6): a long-axis-mode tumbler with the moments of (4179) Toutatis
+    # (1 : 3.05 : 3.19, Hudson & Ostro 1995), 17 observations over 16 days of attitude (sigma 5 deg)
+    # and body rates (sigma 1 deg/day), several local optima: the default starts must find the lowest chi2
+    # (that of a fit started at the truth)
+    t, q, w, truth = toutatis_like()
+    sa, sw = np.deg2rad(5.0), np.deg2rad(1.0)
+    wall, res, _ = C.best_time(
+        lambda: ep.fit(t, attitude=q, attitude_sigma=sa, omega=w, omega_sigma=sw), repeats=repeats, budget=60
+    )
+    best = ep.fit(t, attitude=q, attitude_sigma=sa, omega=w, omega_sigma=sw, initial=truth)
+    add(
+        "fit_toutatis",
+        "fit: Toutatis-like, 17 attitudes (5 deg) + rates (1 deg/day), 16 days",
+        wall,
+        "s",
+        starts=res.n_starts,
+        optima=len(res.local_optima),
+        chi2=float(res.chi2),
+        chi2_from_truth=float(best.chi2),
+        lowest_found=bool(res.chi2 <= best.chi2 * (1 + 1e-9) + 1e-9),
+        observations=17,
+    )
     return out
+
+
+def toutatis_like(seed: int = 0):
+    """(t in days, noisy attitudes, noisy body rates in rad/day, the true initial state as ``fit``'s ``initial``)."""
+    from scipy.spatial.transform import Rotation
+
+    import eulerpoisson as ep
+
+    moments = np.array([1.0, 3.05, 3.19]) / 3.19
+    omega0 = np.array([0.9, 0.25, 0.45])  # rad/day: rotation about the long axis, the long-axis mode
+    q0 = Q0
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, 16.0, 17))
+    t[0] = 0.0
+    tr = ep.solve(ep.RigidBody(moments), t, omega0=omega0, attitude0=q0)
+    noise = Rotation.from_rotvec(np.deg2rad(5.0) * rng.standard_normal((17, 3)))
+    q = (Rotation.from_quat(tr.quaternion, scalar_first=True) * noise).as_quat(scalar_first=True)
+    w = tr.omega + np.deg2rad(1.0) * rng.standard_normal((17, 3))
+    return t, q, w, {"inertia": moments, "omega0": omega0, "attitude0": q0}
 
 
 if __name__ == "__main__":  # pragma: no cover

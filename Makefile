@@ -52,7 +52,10 @@ mujoco: $(VENV)/.installed-test
 	    echo "installed pybullet for the conformance test" ) || \
 	  echo "pybullet is not available: its conformance tests will be skipped"
 
+# the numba kernels are compiled once, two groups at a time, before the tests (which then load them from the cache
+# instead of compiling the same kernels in each pytest-xdist worker)
 test: $(VENV)/.installed-test browser mujoco
+	$(BIN)/eulerpoisson warmup
 	$(BIN)/python -m pytest -n $(WORKERS) -q
 
 # optional peers of the benchmark (heyoka, MuJoCo): installed where possible, skipped otherwise

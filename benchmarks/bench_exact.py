@@ -63,28 +63,34 @@ def counts(nb: int, T: int) -> dict:
     assert not K.USE_NUMBA, "counts need EULERPOISSON_NO_NUMBA=1"
     c = collections.Counter()
 
+    import sys as _sys
+
     def wrap(mod, name, key, weigh=None):
+        """Count the calls of ``mod.name`` wherever the function is referenced (every module of the exact kernels
+        that imported it: the callers look it up in their own globals)."""
         f = getattr(mod, name)
 
         def g(*a):
             c[key] += 1 if weigh is None else weigh(*a)
             return f(*a)
 
-        setattr(mod, name, g)
+        for m in list(_sys.modules.values()):
+            if getattr(m, "__name__", "").startswith("eulerpoisson.solvers.exact") and getattr(m, name, None) is f:
+                setattr(m, name, g)
 
     L = LN.LANES
     wrap(LN, "_rj_jobs", "R_J", lambda X, Y, Z, P, R, n: n)
-    wrap(K, "_rj3", "R_J", lambda *a: int(bool(a[4])) + int(bool(a[9])) + int(bool(a[14])))
+    wrap(K, "rj3", "R_J", lambda *a: int(bool(a[4])) + int(bool(a[9])) + int(bool(a[14])))
     wrap(
         LN,
         "_jacobi_lanes",
         "Jacobi arguments",
         lambda CL, UH, UL, ON, ng, nl, O: int(sum(ON[g * L + l] != 0.0 for g in range(ng) for l in range(nl))),
     )
-    wrap(K, "_sncndn3", "Jacobi arguments", lambda k, *a: k)
-    wrap(K, "_rf_poly", "R_F")
-    wrap(K, "_dd_div_f", "K(m) (AGM in double-double)")
-    wrap(K, "_rc1", "R_C closed forms (atan/log1p) in R_J")
+    wrap(K, "sncndn3", "Jacobi arguments", lambda k, *a: k)
+    wrap(K, "rf_poly", "R_F")
+    wrap(K, "dd_div_f", "K(m) (AGM in double-double)")
+    wrap(K, "rc1", "R_C closed forms (atan/log1p) in R_J")
 
     class _Math:
         def __getattr__(self, name):

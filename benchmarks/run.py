@@ -481,6 +481,13 @@ def summary_markdown(wp, lr, tp, goals, machine, command, quick, tq=None, ft=Non
         L.append("| what | time (s) | starts | distinct optima | reduced chi2 | worst \\|z\\| |")
         L.append("|---|---|---|---|---|---|")
         for r in ft["rows"]:
+            if "reduced_chi2" not in r:  # the Toutatis-like row: chi2 against that of a start at the truth
+                found = "lowest found" if r.get("lowest_found") else "**lowest missed**"
+                L.append(
+                    f"| {r['label']} | {r['value']:.3g} | {r['starts']} | {r['optima']} | chi2 {r['chi2']:.3f} "
+                    f"(from the truth {r['chi2_from_truth']:.3f}) | {found} |"
+                )
+                continue
             L.append(
                 f"| {r['label']} | {r['value']:.3g} | {r['starts']} | {r['optima']} | {r['reduced_chi2']:.3f} "
                 f"| {r['worst_z']:.2f} |"

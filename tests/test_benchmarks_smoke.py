@@ -11,6 +11,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -21,14 +22,26 @@ BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
+    """The benchmark driver run in this process (the package's kernels it compiles serve the later tests).
+
+    benchmarks/run.py sets its environment (one thread, ``EULERPOISSON_NUMPY_BELOW=0``: compiled kernels for
+    every problem) when imported: the environment and the modules of benchmarks/ (``run``, ``_common``,
+    ``bench_*``) are put back afterwards, so that the tests that run later in this process see the defaults.
+    """
     pytest.importorskip("matplotlib")
     out = tmp_path_factory.mktemp("bench")
+    env, modules = dict(os.environ), set(sys.modules)
     sys.path.insert(0, str(BENCH))
     try:
         run = importlib.import_module("run")
         rc = run.main(["--quick", "--peers", "scipy", "--no-readme", "--out", str(out)])
     finally:
         sys.path.remove(str(BENCH))
+        os.environ.clear()
+        os.environ.update(env)
+        for name in set(sys.modules) - modules:
+            if getattr(sys.modules[name], "__file__", None) and Path(sys.modules[name].__file__).parent == BENCH:
+                del sys.modules[name]
     assert rc == 0
     return out
 
@@ -118,9 +131,13 @@ def test_throughput_schema(quick_run):
 def test_fit_schema(quick_run):
     d = _load(quick_run, "fit")
     rows = {r["name"]: r for r in d["rows"]}
-    assert {"fit_100", "fit_100_full", "fit_10000"} <= set(rows)
+    assert {"fit_100", "fit_100_full", "fit_10000", "fit_toutatis"} <= set(rows)
     for r in rows.values():
         assert _pos(r["value"]) and r["unit"] == "s"
+        if r["name"] == "fit_toutatis":
+            # several optima: the default starts find the lowest chi2, that of a fit started at the truth
+            assert r["lowest_found"] and r["chi2"] <= r["chi2_from_truth"] * (1 + 1e-9) + 1e-9
+            continue
         # the fits find the truth: every parameter within 4 standard errors, chi2/dof near 1
         assert r["worst_z"] < 4.0 and 0.7 < r["reduced_chi2"] < 1.3
     assert "Spin-state estimation" in (quick_run / "summary.md").read_text()

@@ -1,10 +1,13 @@
 """One policy for every output (issue: files, long runs and the command line made whole, items 1-4, 6).
 
-The concurrency and interruption tests run real processes.
+The concurrency and interruption tests run real processes. They never depend on timing: such a process
+runs the command line under :data:`LAUNCH`, which holds the run after a chunk of the test's choice until the
+test lets it go on or interrupts it.
 """
 
 import json
 import os
+import shlex
 import signal
 import stat
 import subprocess
@@ -24,6 +27,63 @@ xr = pytest.importorskip("xarray")
 
 EXE = str(Path(sys.executable).with_name("eulerpoisson"))
 SIM = ["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "10"]
+
+# The command line as the program runs it, in a process of its own, with two things the test controls:
+# - Ctrl-C acts whatever the test's process passes on: a suite started in the background (``make test &``, a CI
+#   job) has SIGINT ignored, and an ignored signal stays ignored in every process it starts (POSIX; Python then
+#   installs no KeyboardInterrupt handler): the program rightly keeps running, the interrupt never lands;
+# - after writing the marker of chunk ``PAUSE`` the run touches ``READY`` and waits until ``GO`` exists (or
+#   a Ctrl-C interrupts the wait): the test acts while the run is known to be in the middle, under any load.
+LAUNCH = """
+import signal, sys, time
+from pathlib import Path
+
+signal.signal(signal.SIGINT, signal.default_int_handler)
+signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+from eulerpoisson.cli import main
+from eulerpoisson.io.resumable import PartialRun
+
+pause, ready, go, exe = int(sys.argv[1]), Path(sys.argv[2]), Path(sys.argv[3]), sys.argv[4]
+mark = PartialRun.mark
+
+
+def mark_then_wait(self, k, info):
+    mark(self, k, info)
+    if k == pause:
+        ready.touch()
+        while not go.exists():
+            time.sleep(0.05)
+
+
+PartialRun.mark = mark_then_wait
+sys.argv = [exe, *sys.argv[5:]]
+sys.exit(main())
+"""
+
+
+@pytest.fixture
+def launch(tmp_path):
+    """``launch(pause, *argv)``: the program run with ``argv``, held after chunk ``pause`` (see :data:`LAUNCH`),
+    and the file GO that lets it go on; a run still going when the test ends is killed."""
+    procs = []
+
+    def start(pause, *argv):
+        ready, go = tmp_path / "held", tmp_path / "go"
+        cmd = [sys.executable, "-c", LAUNCH, str(pause), str(ready), str(go), EXE, *argv]
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        procs.append(proc)
+        for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
+            if ready.exists() or proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        assert proc.poll() is None and ready.exists(), f"the run did not reach chunk {pause}: {proc.communicate()}"
+        return proc, go
+
+    yield start
+    for proc in procs:
+        if proc.poll() is None:
+            proc.kill()
+        proc.communicate()
 
 
 def run(capsys, *argv):
@@ -73,44 +133,38 @@ def test_json_of_a_streamed_run_is_the_last_sample_of_the_file(capsys, tmp_path)
     np.testing.assert_array_equal(state["quaternion"], last)
 
 
-def test_a_second_writer_to_the_same_store_fails_and_the_first_finishes(tmp_path):
+def test_a_second_writer_to_the_same_store_fails_and_the_first_finishes(tmp_path, launch):
     store = tmp_path / "c.zarr"
-    argv = [EXE, *SIM, "--t-end", "1000", "--samples", "3000000", "--out", str(store), "--quiet"]
-    first = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    argv = [*SIM, "--t-end", "100", "--samples", "300000", "--out", str(store), "--quiet"]
+    first, go = launch(0, *argv)  # held after its first chunk, with the store's lock
     lock = tmp_path / ".c.zarr.lock"
-    for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
-        if lock.exists() or first.poll() is not None:
-            break
-        time.sleep(0.05)
     assert lock.exists(), "the first writer did not take the lock"
-    second = subprocess.run(argv, capture_output=True, text=True, timeout=HANG_GUARD_S)
+    second = subprocess.run([EXE, *argv], capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert second.returncode == 2
     assert "is being written by another process" in second.stderr and len(second.stderr.strip().splitlines()) == 1
+    go.touch()
     out, err = first.communicate(timeout=HANG_GUARD_S)
     assert first.returncode == 0, err
     with xr.open_zarr(store) as ds:
-        assert ds.sizes["time"] == 3_000_000
+        assert ds.sizes["time"] == 300_000
         assert np.isfinite(ds["quaternion"].values[-1]).all()
     assert not lock.exists()
 
 
-def test_an_interrupted_stream_resumes_where_it_stopped(tmp_path):
+def test_an_interrupted_stream_resumes_where_it_stopped(tmp_path, launch):
     store = tmp_path / "r.zarr"
-    argv = [EXE, *SIM, "--t-end", "2000", "--samples", "4000000", "--method", "taylor", "--out", str(store)]
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    done = tmp_path / ".r.zarr.partial" / "done"
-    for _ in range(int(HANG_GUARD_S / 0.05)):  # polls: a guard against a hang, not a timing
-        if (done.exists() and len(list(done.iterdir())) >= 2) or proc.poll() is not None:
-            break
-        time.sleep(0.05)
-    # 2 of about 40 chunks are done: the rest takes far longer than one poll interval
-    assert proc.poll() is None, "the run ended before it could be interrupted"
+    argv = [*SIM, "--t-end", "200", "--samples", "400000", "--method", "taylor", "--out", str(store)]
+    proc, _ = launch(1, *argv)  # held after 2 of its 4 chunks
     proc.send_signal(signal.SIGINT)
     out, err = proc.communicate(timeout=HANG_GUARD_S)
-    assert proc.returncode != 0 and "run the same command again to resume" in err
-    res = subprocess.run(argv + ["--json"], capture_output=True, text=True, timeout=HANG_GUARD_S)
+    assert proc.returncode == 130, err
+    assert f"run the same command again to resume: {shlex.join(['eulerpoisson', *argv])}" in err
+    done = tmp_path / ".r.zarr.partial" / "done"
+    assert sorted(p.name for p in done.iterdir() if p.name.isdigit()) == ["000000000", "000000001"]
+    assert not store.exists()
+    res = subprocess.run([EXE, *argv, "--json"], capture_output=True, text=True, timeout=HANG_GUARD_S)
     assert res.returncode == 0, res.stderr
-    ref = ep.solve([1, 2, 3], [2000.0], omega0=[1, 0.1, 0.5], method="taylor")
+    ref = ep.solve([1, 2, 3], [200.0], omega0=[1, 0.1, 0.5], method="taylor")
     state = json.loads(res.stdout)
     assert np.max(np.abs(np.array(state["quaternion"]) - ref.quaternion[-1])) < 1e-12
 

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import InvalidInertiaError, InvalidInputError
 from .doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, safe_sqrt, straight, two_prod, two_sum
-from .elliptic import JacobiParams, consts, jacobi_params, rf, rj, sncndn_dd
+from .elliptic import JacobiParams, consts, fused_loops, jacobi_params, rf, rj, sncndn_dd
 from .precision import as_float, float64_by_default
 from .quaternion import qmul_components as _qmul
 
@@ -251,6 +251,25 @@ def _constants(Is, Ms, C) -> tuple[_Body, JacobiParams]:
     return B._replace(Jc=Jc, Jcd=Jcd, Gc=Gc, sn0=sn, theta0=theta0, Jfar0=Jfar0), P
 
 
+def _keep(tree):
+    """``tree`` materialized in the rolled (CPU) form: passed through a conditional on a runtime predicate,
+    across which XLA does not fuse.
+
+    XLA's CPU fusion otherwise copies a shared intermediate (the Jacobi functions, the precession
+    increment) into every consumer, recomputing it several times per element: measured, a third more
+    time and a slower compilation. The values are unchanged (both branches return ``tree``; under ``vmap``
+    the conditional becomes a select). Not in the fused form, which wants one kernel.
+    """
+    if fused_loops():
+        return tree
+    x = jax.tree_util.tree_leaves(tree)[0].reshape(-1)[0]
+
+    def other(t):
+        return jax.tree_util.tree_map(lambda a: a + jnp.zeros((), a.dtype), t)
+
+    return jax.lax.cond(x == x, lambda t: t, other, tree)
+
+
 def _jtot_args(nu, omnu, n, s, c, d, kp, sep):
     """Arguments of the ``R_J`` of ``J(nu; u)`` (``u = n K + r``, values ``s, c, d`` at ``r``).
 
@@ -319,7 +338,7 @@ def _generic(B: _Body, P: JacobiParams, ts):
     dl = jnp.where(near, dl, 0.0)
     # sn, cn, dn of tau and of delta = lambda t in one call
     th, dh, tl, dl = jnp.broadcast_arrays(th, dh, tl, dl)
-    vals = sncndn_dd(jnp.stack([th, dh]), jnp.stack([tl, dl]), P)
+    vals = _keep(sncndn_dd(jnp.stack([th, dh]), jnp.stack([tl, dl]), P))
     sn, cn, dn, n, r, s, c, d = (v[0] for v in vals)
     snd, cnd, dnd, nd, rd, sd, cd, ddd = (v[1] for v in vals)
     theta = _theta(B, P, n, s, c)
@@ -345,7 +364,7 @@ def _generic(B: _Body, P: JacobiParams, ts):
     gdel = jnp.where(use_sh, B.Gc + B.m1 * jd, B.g0 * (dlt - B.g0 * jd))
     near_val = jnp.where(B.caseB, gdel - B.g0 * B.g0 * xadd, jd + xadd)
     far_val = jnp.where(B.caseB, B.m1 * j, j) - B.Jfar0
-    dj = jnp.where(near, near_val, far_val)
+    dj = _keep(jnp.where(near, near_val, far_val))
 
     Mc = B.sc * B.Ac * cn
     M2 = B.sa * B.sc * B.A2 * sn
@@ -363,7 +382,7 @@ def _generic(B: _Body, P: JacobiParams, ts):
     q = _qmul(*qe, *qt)
     q0 = B.q0
     q = _qmul(q0[0], -q0[1], -q0[2], -q0[3], *q)
-    return (M1, M2, M3), q
+    return _keep(((M1, M2, M3), q))
 
 
 def _assemble(components, shape):
@@ -700,13 +719,13 @@ def _motion(inertia, q0, w0, t, *, tensor, shape):
         P = jnp.concatenate([P[..., :, :2], (sign[..., None] * c2)[..., None]], axis=-1)
         M0 = jnp.einsum("...ij,...j->...i", A, w0)
         Mp0 = jnp.einsum("...ji,...j->...i", P, M0)
-        Mp, qr = _principal_motion(ev, Mp0, t)
+        Mp, qr = _keep(_principal_motion(ev, Mp0, t))
         om = jnp.einsum("...ij,...j->...i", P, Mp / ev)
         pw, px, py, pz = _quat_from_rotation(P)
         a = _qmul(pw, px, py, pz, qr[..., 0], qr[..., 1], qr[..., 2], qr[..., 3])
         qr = _qmul(a[0], a[1], a[2], a[3], pw, -px, -py, -pz)
     else:
-        Mp, qr4 = _principal_motion(inertia, inertia * w0, t)
+        Mp, qr4 = _keep(_principal_motion(inertia, inertia * w0, t))
         om = Mp / inertia
         qr = (qr4[..., 0], qr4[..., 1], qr4[..., 2], qr4[..., 3])
     q = _qmul(q0[..., 0], q0[..., 1], q0[..., 2], q0[..., 3], *qr)

@@ -165,7 +165,7 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
         cst[_K.C_SEP] = 1.0 if m1 == 0.0 else 0.0
         cst[_K.C_M] = m
         cst[_K.C_M1] = m1
-        _K.params(m, m1, 1.0, 1.0, 1.0, False, cst)
+        _K.params(m, m1, 1.0, 1.0, 1.0, m < m, cst)  # (m < m: a computed False; a literal compiles params twice)
         K = C[b, L_K]
         finite = math.isfinite(K)
         Ks = K if finite else 1.0
@@ -256,12 +256,16 @@ def heavy_top_kernel(C, t, QF, Q0, OM0, qout, wout):
             rate_c = lam * cc + (0.0 if z1 else kaps / (2.0 * cc))
             rate_s = -lam * ss + (0.0 if z2 else kapd / (2.0 * ss))
             # the angle integrals
+            # (no shift for delta: a computed False, as a literal False would compile the helpers a second time)
+            no_shift = shS and not shS
             sS, s2S, c2S, d2S, pS = _reduced_args(nS, n1S, shS, snS, cnS, dnS, m1)
-            sD, s2D, c2D, d2D, pD = _reduced_args(nD, n1D, False, snD, cnD, dnD, m1)
+            sD, s2D, c2D, d2D, pD = _reduced_args(nD, n1D, no_shift, snD, cnD, dnD, m1)
             rfS, rfD = _rf2(c2S, d2S, 1.0, c2D, d2D, 1.0)
-            rjS, rjD, _r = _K.rj3(c2S, d2S, 1.0, pS, True, c2D, d2D, 1.0, pD, True, 0.0, 0.0, 0.0, 0.0, False)
+            rjS, rjD, _r = _K.rj3(
+                c2S, d2S, 1.0, pS, not no_shift, c2D, d2D, 1.0, pD, not no_shift, 0.0, 0.0, 0.0, 0.0, no_shift
+            )
             perS = _periodic(nS, sS, s2S, rfS, rjS, tr, jj, finite, picS, shS)
-            perD = _periodic(nD, sD, s2D, rfD, rjD, tr, jj, finite, picD, False)
+            perD = _periodic(nD, sD, s2D, rfD, rjD, tr, jj, finite, picD, no_shift)
             dsig = cslin * ts + csper * (perS - perS0)
             ddel = -lam * ts + cdper * (perD - perD0)
             c1 = math.cos(dsig)

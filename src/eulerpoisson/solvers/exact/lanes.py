@@ -634,7 +634,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
             IC[l] = 1.0 * nj
             nj += 1
     if nj > 0:
-        _rj_jobs(JX, JY, JZ, JP, JR, nj)
+        _rj_jobs(JX, JY, JZ, JP, JR, nj + 0)  # (+ 0: an int64, never a literal 0 typed apart)
     for l in range(nl):
         RT[l] = JR[int(IT[l])] if IT[l] >= 0.0 else 0.0
         R0[l] = JR[int(I0[l])] if I0[l] >= 0.0 else 0.0
@@ -710,7 +710,7 @@ def _eval_lanes(CL, TT, ON, OUT, nl):
                 IC[l] = 1.0 * nj
                 nj += 1
         if nj > 0:
-            _rj_jobs(JX, JY, JZ, JP, JR, nj)
+            _rj_jobs(JX, JY, JZ, JP, JR, nj + 0)  # (+ 0: an int64, never a literal 0 typed apart)
         for l in range(nl):
             if ON[l] == 0.0 or NEAR[l] == 0.0:
                 continue
@@ -904,6 +904,7 @@ def motion_lanes(inertia, M0, t, Mout, qout):
         EQ[l] = 0.0
     # blocks of LANES times of one body, or of one time of LANES bodies: the fewer blocks
     if nb * ((T + _L - 1) // _L) <= ((nb + _L - 1) // _L) * T:
+        one = min(nb, 1)
         for b in range(nb):
             i0 = inertia[b, 0]
             i1 = inertia[b, 1]
@@ -911,7 +912,8 @@ def motion_lanes(inertia, M0, t, Mout, qout):
             m0 = M0[b, 0]
             m1 = M0[b, 1]
             m2 = M0[b, 2]
-            setup_lanes(inertia, M0, b, 1, CL, EQ)  # lane 0, copied to the other lanes
+            # lane 0, copied to the other lanes (a computed 1: a literal 1 would compile setup_lanes a second time)
+            setup_lanes(inertia, M0, b, one, CL, EQ)
             if EQ[0] != 0.0:
                 EQ[0] = 0.0
                 for j in range(T):

@@ -440,11 +440,14 @@ def body_setup(i0, i1, i2, m0, m1_, m2, cst):
         True for a relative equilibrium (only the sorting data of ``cst`` is
         filled then).
     """
-    eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = setup_pre(i0, i1, i2, m0, m1_, m2, cst)
+    # a view of any layout ('A'), as the lane kernel passes its strided rows: one compilation of setup_pre and
+    # setup_post serves both (the same memory, the same operations)
+    csa = cst[0::1]
+    eq, m, m1, rx, ry, do_rf, c0, s0, M1, M2, M3 = setup_pre(i0, i1, i2, m0, m1_, m2, csa)
     if eq:
         return True
     rf0 = params(m, m1, rx, ry, 1.0, do_rf, cst)
-    setup_post(cst, rf0, c0, s0, M1, M2, M3)
+    setup_post(csa, rf0, c0, s0, M1, M2, M3)
     return False
 
 

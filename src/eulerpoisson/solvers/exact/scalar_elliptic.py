@@ -306,7 +306,9 @@ def rj3(xa, ya, za, pa, on_a, xb, yb, zb, pb, on_b, xc, yc, zc, pc, on_c):
 
 def rj1(x, y, z, p):
     """One ``R_J(x, y, z, p)`` by :func:`rj3` (its other two jobs off): the same operations as a job of three."""
-    r, _, _ = rj3(x, y, z, p, True, 0.0, 0.0, 0.0, 0.0, False, 0.0, 0.0, 0.0, 0.0, False)
+    # computed flags (x < x is False, NaN included): literal True/False would compile rj3 once more per pattern
+    off = x < x
+    r, _, _ = rj3(x, y, z, p, not off, 0.0, 0.0, 0.0, 0.0, off, 0.0, 0.0, 0.0, 0.0, off)
     return r
 
 

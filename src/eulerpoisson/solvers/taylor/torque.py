@@ -393,16 +393,17 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
         if dt > 0.0:
             h = dt
         else:
-            sw = max(_norm_inf(W, 0, 3), math.sqrt(_norm_inf(W, 1, 3)))
+            # (the row and width as computed int64: literal constants would compile _norm_inf once per value)
+            sw = max(_norm_inf(W, order - order, W.shape[1]), math.sqrt(_norm_inf(W, order - order + 1, W.shape[1])))
             h = math.inf
             for k in (order - 1, order):
                 if k < 1:
                     continue
                 x = math.inf  # the smaller bound of the two groups, then one root
-                nqk = _norm_inf(Q, k, 4)
+                nqk = _norm_inf(Q, k, Q.shape[1])
                 if nqk > 0.0:
                     x = tol / nqk
-                nwk = _norm_inf(W, k, 3)
+                nwk = _norm_inf(W, k, W.shape[1])
                 if nwk > 0.0 and sw > 0.0:
                     x = min(x, tol * sw / nwk)
                 if x < math.inf:

@@ -56,7 +56,7 @@ mujoco: $(VENV)/.installed-test
 # instead of compiling the same kernels in each pytest-xdist worker)
 test: $(VENV)/.installed-test browser mujoco
 	$(BIN)/eulerpoisson warmup
-	$(BIN)/python -m pytest -n $(WORKERS) -q
+	$(BIN)/python -m pytest -n $(WORKERS) --dist loadgroup -q
 
 # optional peers of the benchmark (heyoka, MuJoCo): installed where possible, skipped otherwise
 $(VENV)/.installed-peers: | $(VENV)/.installed-test

@@ -2,6 +2,9 @@
 
 import os
 import pickle
+import re
+import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -29,6 +32,47 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 # optimizing passes take most of that time (2.5x less without them, the same values: they only fuse and
 # schedule); set before jax is imported
 os.environ.setdefault("JAX_DISABLE_MOST_OPTIMIZATIONS", "1")
+# ... and JAX's persistent compilation cache, in a temporary folder of this run that the pytest-xdist workers
+# share (they inherit the controller's environment; the controller removes it at the end): a program one worker
+# or test has compiled (the same function at the same shapes) is read back instead of being compiled again
+if not os.environ.get("PYTEST_XDIST_WORKER") and "JAX_COMPILATION_CACHE_DIR" not in os.environ:
+    _JAX_CACHE = tempfile.mkdtemp(prefix="eulerpoisson-jax-cache-")
+    os.environ["JAX_COMPILATION_CACHE_DIR"] = _JAX_CACHE
+    os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "1")
+else:
+    _JAX_CACHE = None
+
+
+def pytest_unconfigure(config):
+    if _JAX_CACHE is not None:
+        shutil.rmtree(_JAX_CACHE, ignore_errors=True)
+
+
+#: the JAX test files (tests/test_jax_*.py) and the files that share compiled programs (tests/_jax_programs.py)
+_JAX_FILE = re.compile(r"(?:^|/)(test_jax_[^/]*)\.py::")
+_JAX_SHARED = {"test_jax_derivatives": "test_jax_exact"}
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config, log):
+    """``--dist loadgroup`` (the Makefile's test target): each JAX test file is one unit of work (the files of
+    one :data:`_JAX_SHARED` set together), so that the programs its tests compile (the closed form and its
+    derivatives: most of their time) are compiled once, by one worker; the largest units are handed out first
+    (pytest-xdist's ``--loadscope-reorder``), every other test is a unit of its own, as with ``xdist_group``
+    marks. (pytest 9.2 no longer sees the group suffix that pytest-xdist 3.8 gives a marked test's id: the
+    scopes are made here.)"""
+    if config.getvalue("dist") != "loadgroup":
+        return None
+    from xdist.scheduler import LoadGroupScheduling
+
+    class JaxFilesTogether(LoadGroupScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            found = _JAX_FILE.search(nodeid)
+            if found:
+                return "jax:" + _JAX_SHARED.get(found.group(1), found.group(1))
+            return super()._split_scope(nodeid)
+
+    return JaxFilesTogether(config, log)
 
 
 @pytest.fixture

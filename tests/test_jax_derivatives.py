@@ -14,20 +14,16 @@ The attitude sensitivity is compared as the body-frame vector ``eta`` defined by
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import pytest
 
 jax = pytest.importorskip("jax", reason="jax is not installed: pip install 'eulerpoisson[jax]'")
 mpmath = pytest.importorskip("mpmath")
 
-import jax.numpy as jnp  # noqa: E402
-
+import _jax_programs as programs  # noqa: E402  (tests/: the compiled programs the JAX test files share)
 import eulerpoisson as ep  # noqa: E402
 from _torque_reference import reference_motion_mp  # noqa: E402
 from eulerpoisson.estimation.variational import propagate  # noqa: E402
-from eulerpoisson.jax import exact_motion  # noqa: E402
 from eulerpoisson.oracle import reference_cases  # noqa: E402
 
 IDENT = np.array([1.0, 0.0, 0.0, 0.0])
@@ -60,38 +56,23 @@ def _sym(i, j):
 DIRECTIONS = np.array([_sym(0, 0), _sym(1, 1), _sym(2, 2), _sym(0, 1), _sym(0, 2), _sym(1, 2)])
 
 
-@functools.cache
-def _jacobians(moments: bool):
-    """A jitted ``(q, w, dq/dw0, dw/dw0, dq/dI, dw/dI)`` (compiled once per inertia form)."""
-
-    def f(w0, inertia, t):
-        return exact_motion(inertia, jnp.asarray(IDENT), w0, t)
-
-    def all_(w0, inertia, t):
-        q, w = f(w0, inertia, t)
-        (dq_w, dq_i), (dw_w, dw_i) = jax.jacfwd(f, argnums=(0, 1))(w0, inertia, t)
-        return q, w, dq_w, dw_w, dq_i, dw_i
-
-    return jax.jit(all_)
-
-
 def _jax_columns(inertia, omega0, t):
     """(q, w, eta, domega): eta and domega of shapes (T, P, 3), the 3 omega0 columns, then the inertia
-    directions (the 6 of DIRECTIONS for a tensor, the 3 diagonal ones for moments)."""
+    directions (the 6 of DIRECTIONS for a tensor, the 3 diagonal ones for moments).
+
+    Each column is one ``jax.jvp`` (``jax.jacfwd`` is jvp over the basis) of the session's one forward
+    program (tests/_jax_programs.py), at the initial attitude IDENT.
+    """
     inertia = np.asarray(inertia, dtype=float)
     moments = inertia.shape == (3,)
-    with jax.enable_x64(True):
-        out = _jacobians(moments)(jnp.asarray(omega0, dtype=jnp.float64), jnp.asarray(inertia), jnp.asarray(t))
-    q, w, dq_w, dw_w, dq_i, dw_i = (np.asarray(a) for a in out)
-    etas = [_eta(q, dq_w[..., j]) for j in range(3)]
-    dws = [dw_w[..., j] for j in range(3)]
-    if moments:
-        etas += [_eta(q, dq_i[..., j]) for j in range(3)]
-        dws += [dw_i[..., j] for j in range(3)]
-    else:
-        for D in DIRECTIONS:
-            etas.append(_eta(q, np.einsum("tkij,ij->tk", dq_i, D)))
-            dws.append(np.einsum("tkij,ij->tk", dw_i, D))
+    zero_t = np.zeros(len(t))
+    tangents = [(np.zeros_like(inertia), np.eye(3)[j]) for j in range(3)]
+    tangents += [(np.eye(3)[j], np.zeros(3)) for j in range(3)] if moments else [(D, np.zeros(3)) for D in DIRECTIONS]
+    etas, dws = [], []
+    for d_inertia, d_omega in tangents:
+        q, w, dq, dw = programs.jvp(inertia, IDENT, omega0, t, d_inertia, np.zeros(4), d_omega, zero_t)
+        etas.append(_eta(q, dq))
+        dws.append(dw)
     return q, w, np.stack(etas, axis=1), np.stack(dws, axis=1)
 
 
@@ -196,17 +177,23 @@ def test_jacfwd_matches_30_digit_central_differences(inertia, omega0):
     t = np.array([0.5, 4.0])
     coords = [("omega0", k) for k in range(3)] + [("quaternion0", k) for k in range(4)]
     coords += [("inertia", (0, 0)), ("inertia", (1, 2))]
-    with jax.enable_x64(True):
-        args = (jnp.asarray(inertia), jnp.asarray(q0), jnp.asarray(omega0, dtype=jnp.float64), jnp.asarray(t))
-
-        def f(I, q, w):
-            return exact_motion(I, q, w, args[3])
-
-        jq, jw = jax.jacfwd(f, argnums=(0, 1, 2))(*args[:3])
-        # d/dt: the equations of motion at the same points, from the reference at the same times
-        dq_dt, dw_dt = jax.jacfwd(lambda tt: exact_motion(args[0], args[1], args[2], tt))(args[3])
-    jq = [np.asarray(a) for a in jq]
-    jw = [np.asarray(a) for a in jw]
+    # jax.jacfwd, one column (a jvp of the session's one forward program) per input coordinate
+    zeros = (np.zeros((3, 3)), np.zeros(4), np.zeros(3), np.zeros(t.size))
+    jq, jw = [], []
+    for k, shape in enumerate(((3, 3), (4,), (3,))):
+        cq, cw = [], []
+        for flat in range(int(np.prod(shape))):
+            tans = list(zeros)
+            tans[k] = np.zeros(shape)
+            tans[k][np.unravel_index(flat, shape)] = 1.0
+            _, _, dq, dw = programs.jvp(inertia, q0, omega0, t, *tans)
+            cq.append(dq)
+            cw.append(dw)
+        jq.append(np.moveaxis(np.stack(cq), 0, -1).reshape(t.shape + (4,) + shape))
+        jw.append(np.moveaxis(np.stack(cw), 0, -1).reshape(t.shape + (3,) + shape))
+    # d/dt: the equations of motion at the same points, from the reference at the same times (the tangent
+    # of t all ones: each output depends on its own time only, the diagonal of jax.jacfwd in t)
+    _, _, dq_dt, dw_dt = programs.jvp(inertia, q0, omega0, t, *zeros[:3], np.ones(t.size))
     for which, index in coords:
         dq, dw = _mp_central(inertia, q0, omega0, t, which, index)
         if which == "omega0":
@@ -229,5 +216,5 @@ def test_jacfwd_matches_30_digit_central_differences(inertia, omega0):
     I = np.asarray(inertia)
     q_dot = 0.5 * _qmul(qr, np.concatenate([np.zeros((len(t), 1)), wr], axis=-1))
     w_dot = np.linalg.solve(I, np.cross(wr @ I.T, wr).T).T
-    np.testing.assert_allclose(np.diagonal(np.asarray(dq_dt), axis1=0, axis2=2).T, q_dot, atol=1e-12)
-    np.testing.assert_allclose(np.diagonal(np.asarray(dw_dt), axis1=0, axis2=2).T, w_dot, atol=1e-12)
+    np.testing.assert_allclose(dq_dt, q_dot, atol=1e-12)
+    np.testing.assert_allclose(dw_dt, w_dot, atol=1e-12)

@@ -18,6 +18,7 @@ import jax.numpy as jnp  # noqa: E402
 from hypothesis import given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
+import _jax_programs as programs  # noqa: E402  (tests/: the compiled programs the JAX test files share)
 import eulerpoisson as ep  # noqa: E402
 from eulerpoisson.attitude.core import quaternion_from_rotation_matrix  # noqa: E402
 from eulerpoisson.errors import InvalidInertiaError, InvalidInputError, PrecisionError  # noqa: E402
@@ -210,15 +211,9 @@ def _central(fun, x, dx, h):
     return (qp - qm) / (2 * h), (wp - wm) / (2 * h)
 
 
-_JVP = jax.jit(lambda args, tans: jax.jvp(exact_motion, args, tans))
-
-
 def _jvp_all(I, q0, w0, t, dI, dq0, dw0, dt):
-    with jax.enable_x64(True):
-        args = tuple(jnp.asarray(x, jnp.float64) for x in (I, q0, w0, t))
-        tans = tuple(jnp.asarray(x, jnp.float64) for x in (dI, dq0, dw0, dt))
-        (q, w), (dq, dw) = _JVP(args, tans)
-    return np.asarray(q), np.asarray(w), np.asarray(dq), np.asarray(dw)
+    """``jax.jvp`` of ``exact_motion``: the session's one forward program (tests/_jax_programs.py)."""
+    return programs.jvp(I, q0, w0, t, dI, dq0, dw0, dt)
 
 
 DERIV_BODIES = [
@@ -274,10 +269,8 @@ def test_reverse_derivatives_agree_with_forward_and_time_derivative_is_the_equat
     q0 = np.array([0.9, 0.1, -0.3, 0.2])
     w0 = np.array([0.7, -1.1, 2.0])
     t = np.array([0.0, 0.5, 4.0])
-    with jax.enable_x64(True):
-        args = tuple(jnp.asarray(x) for x in (I, q0, w0, t))
-        jr = jax.jit(jax.jacrev(exact_motion, argnums=(0, 1, 2, 3)))(*args)
-    jr = [[np.asarray(a) for a in row] for row in jr]  # [output][input]
+    # jax.jacrev: one vjp (reverse mode) per output entry, of the session's one reverse program
+    jr = programs.jacrev(I, q0, w0, t)  # [output][input]
     rng = np.random.default_rng(11)
     dI = rng.normal(size=(3, 3))
     dI = dI + dI.T
@@ -306,11 +299,10 @@ def test_derivatives_are_finite_where_the_closed_form_is_singular():
     ]
     t = np.array([0.0, 1.0, 5.0])
     q0 = np.array([1.0, 0.0, 0.0, 0.0])
-    grad = jax.jit(jax.grad(lambda *a: sum(jnp.sum(x) for x in exact_motion(*a)), argnums=(0, 1, 2, 3)))
     for I, w0 in bodies:
-        with jax.enable_x64(True):
-            g = grad(*(jnp.asarray(x, jnp.float64) for x in (I, q0, w0, t)))
-        for leaf in jax.tree_util.tree_leaves(g):
+        # the gradient of sum(q) + sum(w): the vjp of ones (the session's one reverse program)
+        g = programs.vjp(I, q0, w0, t, np.ones((t.size, 4)), np.ones((t.size, 3)))
+        for leaf in g:
             assert np.all(np.isfinite(np.asarray(leaf))), (I, w0)
 
 

@@ -328,8 +328,15 @@ def test_jit_vmap_save_every_float32_batches():
 
 
 def _grad_check(loss, args, eps=1e-6, rtol=1e-6):
-    grads = jax.grad(loss, argnums=tuple(range(len(args))))(*args)
-    f = jax.jit(loss)
+    # one compiled program gives the gradient and the values of the central differences (the loss itself):
+    # every argument a float64 array, so that no call differs from another by a weak type
+    args = tuple(np.asarray(a, dtype=np.float64) for a in args)
+    value_and_grad = jax.jit(jax.value_and_grad(loss, argnums=tuple(range(len(args)))))
+    _, grads = value_and_grad(*args)
+
+    def f(*a):
+        return value_and_grad(*a)[0]
+
     for k, g in enumerate(grads):
         g = np.ravel(np.asarray(g))
         assert np.all(np.isfinite(g))

@@ -292,34 +292,56 @@ def test_an_invalid_output_fails_as_on_one_thread(split_everything, monkeypatch)
     assert "NaN" in message
 
 
-@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="needs os.fork")
-def test_a_forked_child_gets_a_pool_of_its_own(split_everything):
-    """The pool's threads do not survive a fork: the child starts its own (it would wait forever otherwise)."""
-    import os
-    import time
+#: the fork scenario, run in a fresh interpreter: a pytest worker may have imported JAX (multithreaded), and
+#: forking a multithreaded process can deadlock whatever the package does (Python warns of it)
+_FORK_SCRIPT = """
+import os, sys, time
+import numpy as np
+import eulerpoisson as ep
+from eulerpoisson.solvers import parallel
+from eulerpoisson.util import jit
 
-    w = np.random.default_rng(4).standard_normal((64, 3))
-    ref = ep.solve([1.0, 2.0, 3.0], TIMES, omega0=w, workers=2)  # the parent's pool exists now
-    assert ref.stats["threads"] == 2
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child
-        code = 1
-        try:
-            tr = ep.solve([1.0, 2.0, 3.0], TIMES, omega0=w, workers=2)
-            code = 0 if tr.stats["threads"] == 2 and np.array_equal(tr.quaternion, ref.quaternion) else 1
-        finally:
-            os._exit(code)
-    deadline = time.monotonic() + HANG_GUARD_S  # a guard against a hang, not a timing
-    while True:
-        done, status = os.waitpid(pid, os.WNOHANG)
-        if done:
-            break
-        if time.monotonic() > deadline:
-            os.kill(pid, 9)
-            os.waitpid(pid, 0)
-            pytest.fail("the forked child did not finish its solve")
-        time.sleep(0.05)
-    assert os.waitstatus_to_exitcode(status) == 0
+parallel.MIN_BODIES, parallel.MIN_WORK, jit.NUMPY_BELOW = 1, 0.0, 0.0  # split every batch, compiled kernels
+os.environ.pop(parallel.ENV_WORKERS, None)
+guard, times = float(sys.argv[1]), np.array([0.0, 0.7, -1.3, 3.0])
+w = np.random.default_rng(4).standard_normal((64, 3))
+ref = ep.solve([1.0, 2.0, 3.0], times, omega0=w, workers=2)  # the parent's pool exists now
+assert ref.stats["threads"] == 2
+pid = os.fork()
+if pid == 0:  # the child
+    code = 1
+    try:
+        tr = ep.solve([1.0, 2.0, 3.0], times, omega0=w, workers=2)
+        code = 0 if tr.stats["threads"] == 2 and np.array_equal(tr.quaternion, ref.quaternion) else 1
+    finally:
+        os._exit(code)
+deadline = time.monotonic() + guard  # a guard against a hang, not a timing
+while True:
+    done, status = os.waitpid(pid, os.WNOHANG)
+    if done:
+        break
+    if time.monotonic() > deadline:
+        os.kill(pid, 9)
+        os.waitpid(pid, 0)
+        sys.exit("the forked child did not finish its solve")
+    time.sleep(0.05)
+sys.exit(os.waitstatus_to_exitcode(status))
+"""
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="needs os.fork")
+def test_a_forked_child_gets_a_pool_of_its_own():
+    """The pool's threads do not survive a fork: the child starts its own (it would wait forever otherwise)."""
+    import subprocess
+    import sys
+
+    res = subprocess.run(
+        [sys.executable, "-c", _FORK_SCRIPT, str(HANG_GUARD_S)],
+        capture_output=True,
+        text=True,
+        timeout=2 * HANG_GUARD_S,
+    )
+    assert res.returncode == 0, res.stderr[-3000:]
 
 
 def test_minus_one_means_every_core(monkeypatch):

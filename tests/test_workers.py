@@ -339,7 +339,7 @@ def test_a_forked_child_gets_a_pool_of_its_own():
         [sys.executable, "-c", _FORK_SCRIPT, str(HANG_GUARD_S)],
         capture_output=True,
         text=True,
-        timeout=2 * HANG_GUARD_S,
+        timeout=HANG_GUARD_S * 2,
     )
     assert res.returncode == 0, res.stderr[-3000:]
 

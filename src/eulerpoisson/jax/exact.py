@@ -105,8 +105,8 @@ def _nz(x, use):
     return jnp.where(use, x, 1.0)
 
 
-def _equilibrium(Is, Ms):
-    """Relative equilibria (``M0 = 0`` or along a principal axis) in the sorted, scaled frame."""
+def _differences(Is, Ms):
+    """``(d21, d32, d31, |M|^2, a1, a3)``: the moment differences and the two sums the regimes are read from."""
     I1, I2, I3 = Is
     M1, M2, M3 = Ms
     d21 = I2 - I1
@@ -115,6 +115,13 @@ def _equilibrium(Is, Ms):
     msq = M1 * M1 + M2 * M2 + M3 * M3
     a1 = M2 * M2 * d21 / I2 + M3 * M3 * d31 / I3
     a3 = M1 * M1 * d31 / I1 + M2 * M2 * d32 / I2
+    return d21, d32, d31, msq, a1, a3
+
+
+def _equilibrium(Is, Ms):
+    """Relative equilibria (``M0 = 0`` or along a principal axis) in the sorted, scaled frame."""
+    M1, _, M3 = Ms
+    d21, d32, _, msq, a1, a3 = _differences(Is, Ms)
     dh = _dd_D(Is, Ms)
     return (msq == 0.0) | (a1 == 0.0) | (a3 == 0.0) | ((dh == 0.0) & (M1 * M1 * d21 == 0.0) & (M3 * M3 * d32 == 0.0))
 
@@ -135,12 +142,7 @@ def _constants(Is, Ms, C) -> tuple[_Body, JacobiParams]:
     """Constants of generic (non-equilibrium) bodies in the sorted, scaled frame (components)."""
     I1, I2, I3 = Is
     M1, M2, M3 = Ms
-    d21 = I2 - I1
-    d32 = I3 - I2
-    d31 = I3 - I1
-    msq = M1 * M1 + M2 * M2 + M3 * M3
-    a1 = M2 * M2 * d21 / I2 + M3 * M3 * d31 / I3
-    a3 = M1 * M1 * d31 / I1 + M2 * M2 * d32 / I2
+    d21, d32, d31, msq, a1, a3 = _differences(Is, Ms)
     D = _dd_D(Is, Ms) / (I1 * I3)
     mn = jnp.sqrt(msq)
 

@@ -13,7 +13,12 @@
   (``EULERPOISSON_NO_NUMBA=1``; the same code numba compiles): Jacobi arguments (each a
   reduction modulo K and a Landen ascent), Carlson R_J and R_F integrals, AGMs for K(m), the
   closed-form R_C terms of the R_J duplications and the C library calls. benchmarks/README.md
-  ("Where the exact method's time goes") compares them with the least the formulas need.
+  ("Where the exact method's time goes") compares them with the least the formulas need;
+* ``call_*``: one body at one time through ``solve`` in fresh interpreters (microseconds, best of
+  many calls): ``call_exact_tiny`` at t = 1e5, ``call_exact_t0`` / ``call_taylor_t0`` at t = 0
+  (tol = 1e-6: the Python around the kernel) beside the kernels alone; without a suffix with numba
+  active (``EULERPOISSON_NUMPY_BELOW=0``, as the benchmarks run), ``_default`` with the default
+  threshold (the exact method's scalar kernel as plain Python, no numba).
 
     .venv/bin/python benchmarks/run.py --only exact [--quick]
     .venv/bin/python benchmarks/bench_exact.py --counts N T     # the counts alone, as JSON
@@ -133,6 +138,71 @@ def _counts_subprocess(nb: int, T: int) -> dict:
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
+_PER_CALL = """
+import json, sys, time
+sys.path.insert(0, {here!r})
+import numpy as np
+import _common as C
+import eulerpoisson as ep
+from eulerpoisson.solvers.exact.motion import exact_motion
+from eulerpoisson.solvers.taylor import kernels as TK
+from eulerpoisson.solvers.taylor.method import auto_order
+I, W = list(C.INERTIA), list(C.OMEGA0)
+n = {n}
+
+def best(fn):
+    fn()
+    out = []
+    for _ in range(n):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return min(out) * 1e6
+
+m, w, q = np.array([I]), np.array([W]), np.array([[1.0, 0.0, 0.0, 0.0]])
+t0, pos, neg = np.array([0.0]), np.array([0]), np.zeros(0, dtype=np.int64)
+qo, wo, st = np.zeros((1, 1, 4)), np.zeros((1, 1, 3)), np.zeros((1, 3), dtype=np.int64)
+order = auto_order(1e-6)
+rows = {{
+    "tiny": best(lambda: ep.solve(I, [1e5], omega0=W, method="exact")),
+    "exact_t0": best(lambda: ep.solve(I, [0.0], omega0=W, method="exact")),
+    "exact_t0_kernel": best(lambda: exact_motion(m, m * w, t0, compiled={compiled})),
+    "taylor_t0": best(lambda: ep.solve(I, [0.0], omega0=W, method="taylor", tol=1e-6)),
+}}
+if TK.USE_NUMBA:
+    rows["taylor_t0_kernel"] = best(lambda: TK.nb_integrate(m, w, q, t0, pos, neg, 1e-6, order, -1.0, 10**6, 1.0, qo, wo, st))
+print(json.dumps(rows))
+"""
+
+
+def _per_call_rows(quick: bool) -> list[tuple[str, str, float]]:
+    """One body at one time through ``solve``, in fresh interpreters: with numba active (the benchmarks'
+    ``EULERPOISSON_NUMPY_BELOW=0``) and with the default threshold (the exact method's plain-Python kernel)."""
+    rows = []
+    n = 50 if quick else 2000
+    for tag, below, compiled in (("", "0", "True"), ("_default", None, '"python"')):
+        env = dict(os.environ, EULERPOISSON_WORKERS="1")
+        env.pop("EULERPOISSON_NUMPY_BELOW", None)
+        if below is not None:
+            env["EULERPOISSON_NUMPY_BELOW"] = below
+        code = _PER_CALL.format(here=str(HERE), n=n, compiled=compiled)
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=3600)
+        if res.returncode != 0:  # pragma: no cover - reported, not fatal
+            print(res.stderr[-2000:])
+            continue
+        r = json.loads(res.stdout.strip().splitlines()[-1])
+        how = "numba active" if below == "0" else "default threshold (no numba)"
+        rows.append((f"call_exact_tiny{tag}", f"solve: one body at t = 1e5, exact, {how}", r["tiny"]))
+        rows.append((f"call_exact_t0{tag}", f"solve: one body at t = 0, exact, {how}", r["exact_t0"]))
+        rows.append((f"call_exact_t0_kernel{tag}", f"exact_motion alone at t = 0, {how}", r["exact_t0_kernel"]))
+        rows.append((f"call_taylor_t0{tag}", f"solve: one body at t = 0, taylor tol 1e-6, {how}", r["taylor_t0"]))
+        if "taylor_t0_kernel" in r:
+            rows.append(
+                (f"call_taylor_t0_kernel{tag}", f"taylor kernel alone at t = 0, tol 1e-6, {how}", r["taylor_t0_kernel"])
+            )
+    return rows
+
+
 def run(quick: bool = False, log=print) -> dict:
     import eulerpoisson as ep
     from eulerpoisson.solvers.exact import kernels as K
@@ -232,6 +302,10 @@ def run(quick: bool = False, log=print) -> dict:
             time_s=wall,
             timed_calls=n,
         )
+
+    # per call: one body at one time, end to end (issue 25 #1) ------------------------------------
+    for name, label, value in _per_call_rows(quick):
+        add(name, label, value, "us")
 
     # the elliptic work, counted ---------------------------------------------------------------
     for name, nb, TT, per in (

@@ -326,6 +326,33 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None, cold=None) -> list[
                 "status": _status(r["value"] <= 0.3),
             }
         )
+        calls = {r["name"]: r["value"] for r in exact["rows"] if r["name"].startswith("call_")}
+        if "call_exact_tiny" in calls:
+            worst = max(v for k, v in calls.items() if k.startswith("call_exact_tiny"))
+            goals.append(
+                {
+                    "goal": "per call: a tiny problem (one body, one time) with the exact method, end to end",
+                    "target": "<= 50 us",
+                    "measured": f"{calls['call_exact_tiny']:.3g} us with numba active; "
+                    f"{calls.get('call_exact_tiny_default', float('nan')):.3g} us with the default threshold "
+                    "(the scalar kernel as plain Python, no numba)",
+                    "ratio": worst / 50.0,
+                    "status": _status(worst <= 50.0),
+                }
+            )
+            around = {
+                "exact": calls["call_exact_t0"] - calls["call_exact_t0_kernel"],
+                "taylor": calls["call_taylor_t0"] - calls.get("call_taylor_t0_kernel", 0.0),
+            }
+            goals.append(
+                {
+                    "goal": "per call: the Python around a kernel (one body at t = 0; taylor at tol = 1e-6)",
+                    "target": "<= 20 us",
+                    "measured": "; ".join(f"{k} {v:.3g} us" for k, v in around.items()) + " (numba active)",
+                    "ratio": max(around.values()) / 20.0,
+                    "status": _status(max(around.values()) <= 20.0),
+                }
+            )
     if cold:
         # whole processes (bench_cold_start.py)
         r, i, n = (

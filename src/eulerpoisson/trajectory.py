@@ -43,6 +43,10 @@ CONVENTIONS = (
 )
 
 
+#: a quaternion whose norm is within this of 1 is stored as it is (4 ulp of 1)
+_UNIT_SLACK = 4 * float(np.finfo(float).eps)
+
+
 def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> np.ndarray:
     """Quaternions (..., T, 4) as a trajectory stores them: normalized, with signs continuous in time.
 
@@ -57,15 +61,17 @@ def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> n
     # memory layout, and then two equal arrays could be normalized differently)
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
-    if np.any(nrm == 0):
+    if (nrm == 0).any():
         raise InvalidInputError("quaternion contains a zero quaternion, which is not a rotation")
     # normalize, but leave already-unit quaternions bit for bit (files round-trip exactly)
-    off = np.abs(nrm - 1.0) > 4 * np.finfo(float).eps
-    if np.any(off):
+    off = np.abs(nrm - 1.0) > _UNIT_SLACK
+    if off.any():
         q = np.where(off, q / nrm, q)
     if not continuous:
         return q
-    if t.size < 2 or np.all(t[1:] >= t[:-1]):  # the usual case: no reordering needed
+    if t.size < 2:
+        return q  # one sample (or none): its sign is kept
+    if np.all(t[1:] >= t[:-1]):  # the usual case: no reordering needed
         return quaternion_make_continuous(q, axis=-2) if q.ndim > 1 else q
     order = np.argsort(t, kind="stable")
     qs = quaternion_make_continuous(np.take(q, order, axis=-2), axis=-2)
@@ -194,7 +200,7 @@ class Trajectory:
             )
         bshape = q.shape[:-2]
         try:
-            ok = np.broadcast_shapes(body.batch_shape, bshape) == bshape
+            ok = body.batch_shape == () or np.broadcast_shapes(body.batch_shape, bshape) == bshape
         except ValueError:
             ok = False
         if not ok:

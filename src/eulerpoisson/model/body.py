@@ -21,7 +21,7 @@ from numpy.typing import ArrayLike, NDArray
 from ..errors import InvalidInertiaError, InvalidInputError
 from ..util.validate import as_bool, as_float_array, describe_value
 
-__all__ = ["RigidBody"]
+__all__ = ["RigidBody", "cached_body"]
 
 #: relative tolerance used to flag symmetric / spherical / planar bodies and
 #: to accept the triangle inequality as an equality
@@ -478,7 +478,11 @@ class RigidBody:
     @property
     def is_diagonal(self) -> bool:
         """The body frame is a principal frame (every tensor of the batch is diagonal)."""
-        return bool(np.all(self.inertia - self.inertia * np.eye(3) == 0))
+        I = self.inertia
+        if I.ndim == 2:  # one body: its six off-diagonal entries (the diagonal ones are finite)
+            (a, b, c), (d, e, f), (g, h, i) = I.tolist()
+            return b == 0 and c == 0 and d == 0 and f == 0 and g == 0 and h == 0
+        return bool(np.all(I - I * np.eye(3) == 0))
 
     @property
     def kind(self) -> str | NDArray[np.str_]:
@@ -626,3 +630,43 @@ class RigidBody:
         from ..util.htmlrepr import body_html
 
         return body_html(self)
+
+
+#: the checked arrays (inertia, principal moments, principal axes) of the bodies made by :func:`cached_body`
+_BODY_CACHE: dict[tuple[float, float, float], tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+_BODY_CACHE_MAX = 256
+
+
+def cached_body(moments: tuple[float, float, float]) -> RigidBody:
+    """``RigidBody(list(moments))``, checked once per distinct moments (for many small calls with the same body).
+
+    Each call returns a new body with arrays of its own (a body's arrays may be changed by whoever holds it);
+    only the checks and the principal data are computed once.
+
+    Parameters
+    ----------
+    moments : tuple of three floats
+        Principal moments.
+
+    Raises
+    ------
+    InvalidInertiaError, InvalidInputError
+        As :class:`RigidBody` (nothing is cached then).
+
+    Examples
+    --------
+    >>> from eulerpoisson.model.body import cached_body
+    >>> a, b = cached_body((1.0, 2.0, 3.0)), cached_body((1.0, 2.0, 3.0))
+    >>> a is b, a.inertia is b.inertia, (a.inertia == b.inertia).all()
+    (False, False, np.True_)
+    """
+    data = _BODY_CACHE.get(moments)
+    if data is None:
+        body = RigidBody(list(moments))
+        if len(_BODY_CACHE) >= _BODY_CACHE_MAX:
+            _BODY_CACHE.clear()
+        _BODY_CACHE[moments] = (body.inertia.copy(), body.principal_moments.copy(), body.principal_axes.copy())
+        return body
+    body = RigidBody.__new__(RigidBody)
+    body._set(data[0].copy(), data[1].copy(), data[2].copy(), None)
+    return body

@@ -129,7 +129,7 @@ class Model:
         self.torques: tuple[Torque, ...] = as_torques(torque)
         shapes = [body.batch_shape] + [tq.batch_shape for tq in self.torques]
         try:
-            self.batch_shape = np.broadcast_shapes(*shapes)
+            self.batch_shape = np.broadcast_shapes(*shapes) if self.torques else body.batch_shape
         except ValueError:
             desc = ", ".join(f"{type(t).__name__} {t.batch_shape}" for t in self.torques)
             raise InvalidInputError(

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike
 
 from ..trajectory import Trajectory
 from .engine import collect, prepare_run
+from .quick import quick_solve
 from .registry import MethodOptions
 
 if TYPE_CHECKING:
@@ -136,6 +137,20 @@ def solve(
     >>> tr.omega.shape
     (2, 3)
     """
+    quick = quick_solve(
+        body,
+        t,
+        omega0=omega0,
+        m0=m0,
+        attitude0=attitude0,
+        gibbs0=gibbs0,
+        torque=torque,
+        method=method,
+        workers=workers,
+        **options,
+    )
+    if quick is not None:  # one free body at a few times: the same result without the general set-up
+        return quick
     run = prepare_run(
         body,
         list(t) if isinstance(t, tuple) else t,  # a tuple is a list of times here (not solve_to_file's grid)

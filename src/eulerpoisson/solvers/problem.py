@@ -219,6 +219,10 @@ def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
     if not problem.model.is_free:
         raise ValueError("compose_initial is a free-body shortcut (left invariance); the model has torques")
     q0 = problem.q0
-    if np.all(q0[..., 0] == 1.0) and not np.any(q0[..., 1:]):
+    if q0.ndim == 1:  # one body (plain floats: cheaper than four array reductions)
+        w, x, y, z = q0.tolist()
+        if w == 1.0 and x == 0.0 and y == 0.0 and z == 0.0:
+            return q_rel
+    elif (q0[..., 0] == 1.0).all() and not q0[..., 1:].any():
         return q_rel
     return qmul(q0[..., None, :], q_rel)

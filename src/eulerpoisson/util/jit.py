@@ -42,6 +42,7 @@ __all__ = [
     "run_shape",
     "numba_wanted",
     "numba_active",
+    "python_twins",
     "activate",
     "lazy_njit",
     "lazy_intrinsic",
@@ -150,6 +151,36 @@ _PENDING_JITABLE: list = []  # (function, options) waiting for register_jitable
 _LAZY: list = []  # every lazy object made before activation
 
 
+#: within :func:`python_twins`: the lazy kernels run their plain-Python twins instead of activating numba
+_TWINS: contextvars.ContextVar[bool] = contextvars.ContextVar("eulerpoisson_python_twins", default=False)
+
+
+@contextlib.contextmanager
+def python_twins() -> Iterator[bool]:
+    """Within it, a kernel not compiled yet runs as plain Python, and numba is neither imported nor activated.
+
+    For problems too small to pay numba's start (:func:`use_compiled`):
+    each :class:`LazyDispatcher` called from Python runs its plain-Python
+    twin (its own function, or the twin given to :func:`lazy_njit` where
+    the compiled version is written differently), each
+    :class:`LazyIntrinsic` its ``python`` twin. The twins perform the same
+    floating-point operations with the same C-library functions, so the
+    numbers are those of the compiled kernels, bit for bit (tested). Once
+    numba is active in the process (a larger problem activated it) the
+    compiled kernels run instead: the same numbers, faster.
+
+    Yields
+    ------
+    bool
+        Whether the twins run (False: numba is active, the compiled kernels run).
+    """
+    token = _TWINS.set(True)
+    try:
+        yield not _ACTIVE
+    finally:
+        _TWINS.reset(token)
+
+
 def numba_active() -> bool:
     """Whether numba has been imported and the kernels made (:func:`activate` ran) in this process."""
     return _ACTIVE
@@ -245,9 +276,11 @@ class LazyDispatcher(_Lazy):
     ``py_func``...) are the dispatcher's.
     """
 
-    def __init__(self, py_func, options):
+    def __init__(self, py_func, options, python=None):
         self.py_func = py_func
         self.options = dict(options)
+        #: the plain-Python twin run within :func:`python_twins` (default: ``py_func`` itself)
+        self.python = py_func if python is None else python
         functools.update_wrapper(self, py_func)
 
     def _make(self):
@@ -256,6 +289,8 @@ class LazyDispatcher(_Lazy):
         return njit(**self.options)(self.py_func)
 
     def __call__(self, *args, **kwargs):
+        if not _ACTIVE and _TWINS.get():
+            return self.python(*args, **kwargs)
         return self.real(*args, **kwargs)
 
     def __getattr__(self, name):
@@ -294,13 +329,15 @@ class LazyIntrinsic(_Lazy):
         return f"<lazy numba intrinsic {self.defn.__qualname__}>"
 
 
-def lazy_njit(func=None, /, **options):
+def lazy_njit(func=None, /, *, python=None, **options):
     """``numba.njit`` made on first use: ``lazy_njit(**options)(f)`` or ``lazy_njit(f)``.
 
     Returns a :class:`LazyDispatcher` before numba is used in this process
     (see :func:`activate`), the ``numba.njit`` dispatcher itself after.
     The options are those of ``numba.njit`` (``cache=True``, ``nogil``,
-    ``fastmath``, ``inline``...), passed unchanged.
+    ``fastmath``, ``inline``...), passed unchanged. ``python``: the
+    plain-Python twin that :func:`python_twins` runs, where ``f`` itself
+    is written for the compiler only (intrinsics); default ``f``.
     """
 
     def wrap(f):
@@ -309,7 +346,7 @@ def lazy_njit(func=None, /, **options):
                 from numba import njit
 
                 return njit(**options)(f)
-            lazy = LazyDispatcher(f, options)
+            lazy = LazyDispatcher(f, options, python)
             _LAZY.append(lazy)
             return lazy
 

@@ -37,6 +37,24 @@ def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite:
     InvalidInputError
         If the trailing shape is wrong or a value is NaN or infinite.
     """
+    if type(x) is np.ndarray and x.dtype == _FLOAT64:
+        a = x  # the common case (the checks below, without the conversions)
+    else:
+        a = _convert(x, name)
+    nt = len(tail)
+    if nt and (a.ndim < nt or a.shape[a.ndim - nt :] != tuple(tail)):
+        want = "(..., " + ", ".join(str(t) for t in tail) + ")"
+        raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
+    if not allow_nonfinite and not np.isfinite(a).all():
+        raise InvalidInputError(f"{name} contains NaN or infinite values: {describe_value(a)}")
+    return a
+
+
+_FLOAT64 = np.dtype(np.float64)
+
+
+def _convert(x, name: str) -> np.ndarray:
+    """``x`` as a float64 array (:func:`as_float_array` without the shape and finiteness checks)."""
     if isinstance(x, (str, bytes)):
         raise TypeError(f"{name} must be numeric, got the string {x!r}")
     if isinstance(x, np.ma.MaskedArray):
@@ -49,14 +67,7 @@ def as_float_array(x, name: str, tail: tuple[int, ...] = (), *, allow_nonfinite:
         raise TypeError(f"{name} must be a real numeric array, got dtype {a.dtype}")
     if np.iscomplexobj(a):
         raise TypeError(f"{name} must be real, got complex dtype {a.dtype}")
-    a = a.astype(np.float64, copy=False)
-    nt = len(tail)
-    if nt and (a.ndim < nt or a.shape[a.ndim - nt :] != tuple(tail)):
-        want = "(..., " + ", ".join(str(t) for t in tail) + ")"
-        raise InvalidInputError(f"{name} must have shape {want}, got shape {a.shape}")
-    if not allow_nonfinite and not np.all(np.isfinite(a)):
-        raise InvalidInputError(f"{name} contains NaN or infinite values: {describe_value(a)}")
-    return a
+    return a.astype(np.float64, copy=False)
 
 
 def as_scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, integer: bool = False) -> float:

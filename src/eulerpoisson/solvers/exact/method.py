@@ -31,12 +31,14 @@ Comput. 30 (2008) 2084-2112.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...attitude.core import quaternion_from_rotation_matrix
 from ...numerics.quaternion import qmul
+from ...util import jit
 from ..problem import Problem, compose_initial
 from ..registry import Method, MethodOptions, MethodResult, register_method
 
@@ -155,6 +157,8 @@ class Exact(Method):
 
     #: compiled kernels or NumPy, chosen for a whole batch by :meth:`for_batch` (None: from the problem run)
     _compiled: bool | None = None
+    #: the free body's path (:meth:`_free_path`), chosen for a whole batch by :meth:`for_batch`
+    _path: str | None = None
     #: whether the body frame is the principal frame of every body, decided for a whole batch by
     #: :meth:`for_batch` (None: from the problem run), so that a chunk of diagonal tensors in a batch
     #: that has full ones takes the same path as the whole batch (the same signs of zeros)
@@ -166,25 +170,47 @@ class Exact(Method):
         Measured (benchmarks/README.md, cold start): the free body about 2 ms per call, 8 microseconds per
         body and 2 per (body, time); the Lagrange top about 5 ms, 20 and 2.5.
         """
-        from ...util.jit import run_shape
-
         # a part of a larger run (chunks of times or points): the size of the whole run decides
-        B, T = run_shape(int(np.prod(problem.batch_shape, dtype=int)), problem.t.shape[0])
+        B, T = jit.run_shape(math.prod(problem.batch_shape), problem.t.shape[0])
         if not problem.model.is_free:
             return 5e-3 + 20e-6 * B + 2.5e-6 * B * T
         return 2e-3 + 8e-6 * B + 2e-6 * B * T
 
-    def _use_compiled(self, problem: Problem) -> bool:
-        from ...util.jit import use_compiled
+    def python_estimate(self, problem: Problem) -> float:
+        """Seconds of the scalar kernel run as plain Python (the free body): about 0.1 ms per body and 0.11 ms
+        per (body, time) (the compiled kernel's numbers, no numba start; :func:`~eulerpoisson.util.jit.python_twins`)."""
+        B, T = jit.run_shape(math.prod(problem.batch_shape), problem.t.shape[0])
+        return 1.0e-4 * B + 1.1e-4 * B * T
 
-        return self._compiled if self._compiled is not None else use_compiled(self.numpy_estimate(problem))
+    def _free_path(self, problem: Problem) -> str:
+        """The free body's path, from the size of the run alone: ``"compiled"``, ``"python"`` or ``"numpy"``.
+
+        The compiled kernels above :func:`~eulerpoisson.util.jit.use_compiled`'s threshold; below it, where the
+        scalar kernel as plain Python is faster than NumPy (a few evaluations), that (or the compiled kernel
+        when numba is already active in the process: the same numbers, bit for bit); NumPy otherwise.
+        """
+        if self._path is not None:
+            return self._path
+        numpy_seconds = self.numpy_estimate(problem)
+        if jit.use_compiled(numpy_seconds):
+            return "compiled"
+        if self.python_estimate(problem) < numpy_seconds:
+            return "compiled" if jit.USE_NUMBA and jit.numba_active() else "python"
+        return "numpy"
+
+    def _use_compiled(self, problem: Problem) -> bool:
+        return self._compiled if self._compiled is not None else jit.use_compiled(self.numpy_estimate(problem))
 
     def for_batch(self, problem: Problem) -> Exact:
         """This method with the batch-wide choices made: compiled kernels or NumPy (:meth:`numpy_estimate`), principal frame."""
         import copy
 
         planned = copy.copy(self)
-        planned._compiled = self._use_compiled(problem)
+        if problem.model.is_free:
+            planned._path = self._free_path(problem)
+            planned._compiled = planned._path == "compiled"
+        else:
+            planned._compiled = self._use_compiled(problem)
         planned._principal = _principal_frame(problem)
         return planned
 
@@ -193,7 +219,8 @@ class Exact(Method):
 
         if not problem.model.is_free:
             return self._run_lagrange(problem)
-        compiled = self._use_compiled(problem)
+        path = self._free_path(problem)
+        compiled: bool | str = {"compiled": True, "numpy": False}.get(path, path)
 
         _check_phase_range(problem)
         Ip = problem.principal_moments
@@ -217,7 +244,7 @@ class Exact(Method):
         return MethodResult(
             q=q,
             omega=omega,
-            stats={"evaluations": int(np.prod(q.shape[:-1])), "compiled": bool(compiled and _numba_in_use())},
+            stats={"evaluations": int(np.prod(q.shape[:-1])), "compiled": bool(path == "compiled" and _numba_in_use())},
         )
 
     def work_estimate(self, problem: Problem) -> float:
@@ -272,9 +299,12 @@ def _numba_in_use() -> bool:
     return USE_NUMBA
 
 
+_IDENTITY9 = np.eye(3).reshape(9)
+
+
 def _all_identity(frames) -> bool:
     """Whether every 3x3 matrix of ``frames`` (shape ``(..., 3, 3)``) is the identity, exactly."""
-    return bool(np.all(np.reshape(frames, (-1, 9)) == np.eye(3).reshape(9)))
+    return bool((np.reshape(frames, (-1, 9)) == _IDENTITY9).all())
 
 
 def _principal_frame(problem: Problem) -> bool:

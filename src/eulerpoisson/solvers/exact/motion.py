@@ -245,12 +245,12 @@ def _validate(inertia, M0):
         raise InvalidInertiaError(f"inertia must have shape (..., 3) (principal moments), got shape {inertia.shape}")
     if M0.ndim < 1 or M0.shape[-1] != 3:
         raise InvalidInputError(f"M0 must have shape (..., 3), got shape {M0.shape}")
-    if not np.all(np.isfinite(inertia)):
+    if not np.isfinite(inertia).all():
         raise InvalidInertiaError("inertia must be finite; got non-finite principal moments")
-    if np.any(inertia <= 0.0):
+    if (inertia <= 0.0).any():
         bad = inertia[inertia <= 0.0].ravel()[0].item()
         raise InvalidInertiaError(f"principal moments of inertia must be > 0, got {bad!r}")
-    if not np.all(np.isfinite(M0)):
+    if not np.isfinite(M0).all():
         raise InvalidInputError("M0 must be finite; got non-finite angular momentum")
     if inertia.shape == M0.shape:  # common case, no broadcasting needed
         batch = inertia.shape[:-1]
@@ -273,7 +273,7 @@ def _validate_t(t):
         raise InvalidInputError(f"t must be a real 1-d array of times, got {t!r}") from exc
     if t.ndim != 1:
         raise InvalidInputError(f"t must be a 1-d array of shape (T,), got shape {t.shape}")
-    if not np.all(np.isfinite(t)):
+    if not np.isfinite(t).all():
         raise InvalidInputError("t must be finite; got non-finite times")
     return t
 
@@ -763,12 +763,16 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
         Times, any order and sign.
     chunk_size : int, optional
         Number of (body, time) pairs evaluated at once (memory bound only).
-    compiled : bool or None, optional
+    compiled : bool, "python" or None, optional
         None (default): the compiled kernel when numba is in use, else
         NumPy; False: the NumPy path; True: the compiled kernel where numba
-        is in use (NumPy otherwise). ``solve(..., method="exact")`` passes
-        False for small problems, which NumPy solves faster than numba is
-        imported (:func:`eulerpoisson.util.jit.use_compiled`).
+        is in use (NumPy otherwise); ``"python"``: the scalar kernel run as
+        plain Python (:func:`eulerpoisson.util.jit.python_twins`: the
+        compiled kernel's numbers bit for bit, no numba start; about 0.1 ms
+        per body and per (body, time), for a few evaluations).
+        ``solve(..., method="exact")`` passes ``"python"`` for a few
+        evaluations and False for other small problems, which NumPy solves
+        faster than numba is imported (:func:`eulerpoisson.util.jit.use_compiled`).
 
     Returns
     -------
@@ -835,6 +839,10 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
         raise InvalidInputError(f"chunk_size must be a positive integer, got {chunk_size}")
     from ...util.jit import USE_NUMBA  # (the kernels module is imported by the compiled path only)
 
+    if isinstance(compiled, str):
+        if compiled != "python":
+            raise InvalidInputError(f"compiled must be True, False, None or 'python', got {compiled!r}")
+        return _exact_motion_compiled(inertia, M0, t, python=True)
     if USE_NUMBA and compiled is not False:
         return _exact_motion_compiled(inertia, M0, t)
     return _exact_motion_numpy(inertia, M0, t, chunk_size)
@@ -842,11 +850,17 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
 
 def _kernel_array(x):
     """C-contiguous, aligned, writeable float64 (one compiled signature per kernel)."""
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        f = x.flags
+        if f.c_contiguous and f.aligned and f.writeable:
+            return x
     return np.require(x, dtype=np.float64, requirements=["C_CONTIGUOUS", "ALIGNED", "WRITEABLE"])
 
 
-def _exact_motion_compiled(inertia, M0, t):
-    """Compiled path of :func:`exact_motion` (``t`` already validated)."""
+def _exact_motion_compiled(inertia, M0, t, python=False):
+    """Compiled path of :func:`exact_motion` (``t`` already validated); ``python``: the scalar kernel as plain
+    Python (the same numbers: the lane kernel and the scalar one agree bit for bit, and so do their twins)."""
+    from ...util.jit import python_twins
     from . import kernels as _K
 
     inertia, M0, batch = _validate(inertia, M0)
@@ -856,7 +870,11 @@ def _exact_motion_compiled(inertia, M0, t):
     Mout = np.empty((nb, T, 3))
     qout = np.empty((nb, T, 4))
     if nb and T:
-        _K.motion_kernel(inertia, M0, t, Mout, qout)
+        if python:
+            with python_twins():
+                _K.motion_kernel_scalar(inertia, M0, t, Mout, qout)
+        else:
+            _K.motion_kernel(inertia, M0, t, Mout, qout)
     return ExactMotion(Mout.reshape(batch + (T, 3)), qout.reshape(batch + (T, 4)))
 
 

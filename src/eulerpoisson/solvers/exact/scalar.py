@@ -63,6 +63,7 @@ from .scalar_elliptic import (
     dd_add,
     dd_mul,
     fast_sqrt,
+    lib_hypot,
     params,
     quick_two_sum,
     rj1,
@@ -635,7 +636,7 @@ def setup_pre(i0, i1, i2, m0, m1_, m2, cst):
     if eq:
         cst[C_REGIME] = EQUILIBRIUM
         return True, 0.5, 0.5, 1.0, 1.0, False, 1.0, 0.0, 0.0, 0.0, 0.0
-    c0, s0, delta2 = pre_amplitude(math.hypot(x, y), x, y, m, m1)
+    c0, s0, delta2 = pre_amplitude(lib_hypot(x, y), x, y, m, m1)
     _pre_store(cst, m, m1, sep, caseB, Ac, A2, Aa, lam, sa, sc, rate, coef, Nadd, nu, omnu, Cadd, g0)
     return False, m, m1, c0 * c0, delta2, not sep, c0, s0, M1, M2, M3
 
@@ -933,10 +934,14 @@ if USE_NUMBA:  # pragma: no branch
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)
 
-    def _jiti(f):
+    def _jiti(f, python=None):
         """Small helpers: inlined into their callers by numba (a call between compiled functions
-        is otherwise an indirect call that LLVM can neither inline nor vectorize)."""
-        return _njit(cache=True, nogil=True, error_model="numpy", forceinline=True)(f)
+        is otherwise an indirect call that LLVM can neither inline nor vectorize). ``python``: the
+        plain-Python twin of a function written for the compiler (util.jit.python_twins)."""
+        return _njit(cache=True, nogil=True, error_model="numpy", forceinline=True, python=python)(f)
+
+    # the plain-Python forms of the functions written differently for the compiler below (the same numbers)
+    _py_pow2, _py_exponent, _py_exponent_lane, _py_dv = pow2, _exponent, exponent_lane, _dv
 
     @_intrinsic
     def _bits(typingctx, x):
@@ -973,9 +978,9 @@ if USE_NUMBA:  # pragma: no branch
         be = (_bits(x) >> 52) & 0x7FF
         return be - 1022, be != 0
 
-    pow2 = _jiti(pow2)
-    _exponent = _jiti(_exponent)
-    exponent_lane = _jiti(exponent_lane)
+    pow2 = _jiti(pow2, _py_pow2)
+    _exponent = _jiti(_exponent, _py_exponent)
+    exponent_lane = _jiti(exponent_lane, _py_exponent_lane)
     _ldexp = _jiti(_ldexp)
     _mod2 = _jiti(_mod2)
     _mod8 = _jiti(_mod8)
@@ -996,7 +1001,7 @@ if USE_NUMBA:  # pragma: no branch
     def _dv(a, b):  # noqa: F811 - compiled: the IEEE division (error_model="numpy")
         return a / b
 
-    _dv = _jiti(_dv)
+    _dv = _jiti(_dv, _py_dv)
     perm3 = _jiti(perm3)
     pick3 = _jiti(pick3)
     pre_regime = _jiti(pre_regime)

@@ -63,6 +63,7 @@ from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA 
 from .state import C_KH, C_KL, C_KP, C_M, C_M1, C_NLEV, C_PCL, C_PCORR, C_PH, C_SEP, C_SQM, MAX_LANDEN
 
 __all__ = [
+    "lib_hypot",
     "dd_add",
     "dd_mul",
     "quick_two_sum",
@@ -151,6 +152,12 @@ def dd_sqrt_f(ah, al):
     else:
         corr = 0.0
     return quick_two_sum(x, corr)
+
+
+def lib_hypot(x, y):
+    """The C library's ``hypot(x, y)`` (compiled: numba's ``math.hypot`` calls it; in Python, NumPy's scalar
+    ``hypot`` calls it, while Python's ``math.hypot`` has an algorithm of its own that can differ by an ulp)."""
+    return float(np.hypot(x, y))
 
 
 def fast_sqrt(x):
@@ -647,10 +654,14 @@ if USE_NUMBA:  # pragma: no branch
     def _jit(f):
         return _njit(cache=True, nogil=True, error_model="numpy")(f)
 
-    def _jiti(f):
+    def _jiti(f, python=None):
         """Small helpers: inlined into their callers by numba (a call between compiled functions
-        is otherwise an indirect call that LLVM can neither inline nor vectorize)."""
-        return _njit(cache=True, nogil=True, error_model="numpy", forceinline=True)(f)
+        is otherwise an indirect call that LLVM can neither inline nor vectorize). ``python``: the
+        plain-Python twin of a function written for the compiler (util.jit.python_twins)."""
+        return _njit(cache=True, nogil=True, error_model="numpy", forceinline=True, python=python)(f)
+
+    # the plain-Python forms of the functions written for the compiler below (the same numbers)
+    _py_fast_sqrt, _py_two_prod_f = fast_sqrt, _two_prod_f
 
     @_intrinsic
     def _fma(typingctx, a, b, c):
@@ -664,7 +675,7 @@ if USE_NUMBA:  # pragma: no branch
 
         return sig, codegen
 
-    @_intrinsic
+    @_intrinsic(python=_py_fast_sqrt)
     def fast_sqrt(typingctx, x):  # noqa: F811 - the compiled version is the LLVM intrinsic
         """Correctly rounded ``sqrt(x)`` (``llvm.sqrt.f64``, bitwise equal to the C library's)."""
         sig = _types.float64(_types.float64)
@@ -686,7 +697,8 @@ if USE_NUMBA:  # pragma: no branch
     two_prod = _jiti(two_prod)
     dd_add = _jiti(dd_add)
     dd_mul = _jiti(dd_mul)
-    _two_prod_f = _jiti(_two_prod_f)
+    _two_prod_f = _jiti(_two_prod_f, _py_two_prod_f)
+    lib_hypot = _jiti(lib_hypot)
     dd_mul_f = _jiti(dd_mul_f)
     _dd_mul_d_f = _jiti(_dd_mul_d_f)
     dd_div_f = _jiti(dd_div_f)

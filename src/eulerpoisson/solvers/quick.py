@@ -1,0 +1,216 @@
+r"""The quick lane of :func:`~eulerpoisson.solve`: one free body at a few times, without the engine's set-up.
+
+A call such as ``ep.solve(body, [t], omega0=w)`` spends most of its time in
+the general set-up (:func:`~eulerpoisson.solvers.engine.prepare_run`: the
+options checked, the arguments converted and broadcast, the segments
+planned), not in the method. :func:`quick_solve` recognizes the plain case
+and does only what it needs:
+
+* one free body: a :class:`~eulerpoisson.RigidBody` of batch shape ``()``
+  or three principal moments (validated once per distinct moments,
+  :func:`~eulerpoisson.model.body.cached_body`), no torque;
+* ``omega0`` three finite numbers, ``attitude0`` None or one quaternion,
+  no ``m0``/``gibbs0``/``workers``;
+* at most :data:`QUICK_MAX_TIMES` finite output times;
+* the method by name (or None: the default for the free body, ``exact``),
+  with options of plain values (their checked configuration is kept in a
+  small cache).
+
+It then calls what the engine calls (the method's :meth:`~.Method.for_batch`
+and :meth:`~.Method.run` through :func:`~.parallel.solve_batch`, the same
+:class:`~eulerpoisson.trajectory.Trajectory`), so the result is the one of
+the general path, bit for bit and field for field (tested). Anything else,
+including every input that is not valid, returns None: the general path
+then solves it or raises its error.
+"""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import InvalidInputError
+from ..model.body import RigidBody, cached_body
+from ..model.equations import Model
+from ..trajectory import Trajectory
+from ..util.jit import run_shape, whole_run
+from . import engine
+from .parallel import solve_batch
+from .problem import Problem, initial_quaternion
+from .registry import check_supported, get_method
+
+if TYPE_CHECKING:
+    from .registry import Method
+
+__all__ = ["QUICK_MAX_TIMES", "quick_solve"]
+
+#: most output times a call takes through the quick lane
+QUICK_MAX_TIMES = 64
+
+#: configured methods by (name, options): the checked options of the calls seen (bounded)
+_CONFIGURED: dict[tuple, Method] = {}
+_CONFIGURED_MAX = 64
+
+_FLOAT64 = np.dtype(np.float64)
+_IDENTITY = (1.0, 0.0, 0.0, 0.0)
+
+
+def _number(x: Any) -> float | None:
+    """A finite Python float from an int or a float (NumPy float64 included), else None."""
+    if type(x) is float or type(x) is int or type(x) is np.float64:
+        v = float(x)
+        return v if math.isfinite(v) else None
+    return None
+
+
+def _floats(x: Any, n: int | None) -> list[float] | None:
+    """``x`` as a list of finite floats (length ``n``, or 1 to :data:`QUICK_MAX_TIMES` when None), else None."""
+    if type(x) is np.ndarray:
+        if x.dtype != _FLOAT64 or x.ndim != 1:
+            return None
+        seq = x.tolist()
+    elif type(x) is list or type(x) is tuple:
+        seq = x
+    else:
+        return None
+    if (len(seq) != n) if n is not None else not 1 <= len(seq) <= QUICK_MAX_TIMES:
+        return None
+    out = []
+    for v in seq:
+        f = _number(v)
+        if f is None:
+            return None
+        out.append(f)
+    return out
+
+
+def _configured(name: str, options: dict[str, Any]) -> Method | None:
+    """The configured method (cached by its plain option values), or None where the general path must decide."""
+    key_items = []
+    for k, v in options.items():
+        if v is not None and type(v) not in (bool, int, float, str):
+            return None
+        key_items.append((k, type(v).__name__, v))
+    key = (name, tuple(sorted(key_items)))
+    m = _CONFIGURED.get(key)
+    if m is not None:
+        try:
+            registered = get_method(name)
+        except InvalidInputError:
+            registered = None  # unregistered since (a plug-in): the general path raises
+        if type(m) is not registered:
+            _CONFIGURED.pop(key, None)
+            m = None
+    if m is None:
+        try:
+            _, m = engine.configure_method(name, dict(options))
+        except (TypeError, InvalidInputError):
+            return None  # the general path raises it
+        if m is None:  # pragma: no cover - a name is given
+            return None
+        if len(_CONFIGURED) >= _CONFIGURED_MAX:
+            _CONFIGURED.clear()
+        _CONFIGURED[key] = m
+    return m
+
+
+def _body(body: Any) -> RigidBody | None:
+    if type(body) is RigidBody:
+        return body if body.batch_shape == () else None
+    moments = _floats(body, 3)
+    if moments is None:
+        return None
+    try:
+        return cached_body((moments[0], moments[1], moments[2]))
+    except (TypeError, ValueError, InvalidInputError):
+        return None  # the general path raises it
+
+
+def quick_solve(
+    body: Any,
+    t: Any,
+    *,
+    omega0: Any = None,
+    m0: Any = None,
+    attitude0: Any = None,
+    gibbs0: Any = None,
+    torque: Any = None,
+    method: Any = None,
+    workers: Any = None,
+    **options: Any,
+) -> Trajectory | None:
+    """:func:`~eulerpoisson.solve` of one free body at a few times, or None where the general path must run.
+
+    The arguments are those of :func:`~eulerpoisson.solve` (a tuple ``t`` is a list of times there too).
+
+    Returns
+    -------
+    Trajectory or None
+        The trajectory the general path returns, bit for bit; None when the call is not of the plain kind
+        described in the module notes (or has an invalid input: the general path raises its error).
+    """
+    start = _time.perf_counter()
+    if torque is not None or m0 is not None or gibbs0 is not None or workers is not None or omega0 is None:
+        return None
+    if method is None:
+        if options:
+            return None
+        name = "exact"  # the default method of the free body (engine.default_method)
+    elif type(method) is str:
+        name = method
+    else:
+        return None
+    times = [f] if (f := _number(t)) is not None else _floats(t, None)
+    w = _floats(omega0, 3)
+    if times is None or w is None:
+        return None
+    m = _configured(name, options)
+    b = _body(body)
+    if m is None or b is None:
+        return None
+    if attitude0 is None:
+        q0 = np.array(_IDENTITY)
+    else:
+        if _floats(attitude0, 4) is None:
+            return None
+        try:
+            q0 = initial_quaternion(attitude0, None).copy()
+        except (TypeError, InvalidInputError):
+            return None
+    model = Model(b)
+    cls = type(m)
+    try:
+        check_supported(m, model)  # the configured method: its options count (a free-body-only scheme)
+    except (TypeError, ValueError, InvalidInputError):
+        return None
+    tt = np.array(times)
+    if not cls.negative_times and min(times) < 0:
+        return None
+    wa = np.array(w)
+    if cls.order is not None:
+        # a stepping method's long run is cut into segments (engine.plan_segments): the general path
+        # as prepare_run computes it (a sum of three in order, a correctly rounded square root)
+        turns = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * max(abs(v) for v in times)
+        if not (math.isfinite(turns) and turns <= engine.SEGMENT_TURNS):
+            return None
+    problem = Problem(model=model, q0=q0, omega0=wa, t=tt)
+    n = len(times)
+    with whole_run(*run_shape(0, n)):
+        planned = m.for_batch(problem)
+        res = solve_batch(planned, problem, None)
+    tr = Trajectory(
+        t=tt,
+        quaternion=res.q,
+        omega=res.omega,
+        body=b,
+        torque=model.torques,
+        method=name,
+        options=dict(planned.config),
+        stats={"wall_time": 0.0, **res.stats},
+        _prepared=res.prepared,
+    )
+    tr.stats["wall_time"] = _time.perf_counter() - start
+    return tr

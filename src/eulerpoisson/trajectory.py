@@ -10,6 +10,7 @@ Trajectories are written to and read from NetCDF with CF-style attributes.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
@@ -45,6 +46,8 @@ CONVENTIONS = (
 
 #: a quaternion whose norm is within this of 1 is stored as it is (4 ulp of 1)
 _UNIT_SLACK = 4 * float(np.finfo(float).eps)
+#: at most this many samples are checked in plain floats
+_FEW = 8
 
 
 def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> np.ndarray:
@@ -59,6 +62,14 @@ def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> n
     """
     # a fixed summation order (an einsum or a reduction may sum in an order that depends on the
     # memory layout, and then two equal arrays could be normalized differently)
+    if q.ndim == 2 and q.shape[0] <= _FEW and (not continuous or q.shape[0] < 2):
+        # a few samples that need no sign change: the same test in plain floats (the same operations)
+        for w, x, y, z in q.tolist():
+            n = math.sqrt(w * w + x * x + y * y + z * z)
+            if n == 0 or abs(n - 1.0) > _UNIT_SLACK:
+                break  # (normalized, or refused, below)
+        else:
+            return q
     w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     nrm = np.sqrt(w * w + x * x + y * y + z * z)[..., None]
     if (nrm == 0).any():

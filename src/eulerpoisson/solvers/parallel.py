@@ -90,6 +90,7 @@ from __future__ import annotations
 
 import contextvars
 import itertools
+import math
 import numbers
 import os
 import threading
@@ -370,7 +371,7 @@ def solve_batch(method: Method, problem: Problem, workers: int | None = None) ->
     ``threads`` (the number of threads that ran). See the module docstring.
     """
     n_workers = resolve_workers(workers)
-    B = int(np.prod(problem.batch_shape, dtype=int))
+    B = math.prod(problem.batch_shape)
     bounds = None
     if method.threads and n_workers > 1 and B >= MIN_BODIES and not getattr(_STATE, "running", False):
         bounds = plan_chunks(B, n_workers, method.work_estimate(problem))

@@ -80,7 +80,12 @@ class Problem:
 
     @property
     def principal_moments(self) -> np.ndarray:
-        return np.broadcast_to(self.body.principal_moments, self.batch_shape + (3,))
+        pm = self.body.principal_moments
+        if pm.shape[:-1] == self.batch_shape:  # no broadcast needed: a read-only view, as broadcast_to gives
+            view = pm.view()
+            view.flags.writeable = False
+            return view
+        return np.broadcast_to(pm, self.batch_shape + (3,))
 
     @property
     def principal_axes(self) -> np.ndarray:

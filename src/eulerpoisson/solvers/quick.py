@@ -151,6 +151,15 @@ def quick_solve(
     Trajectory or None
         The trajectory the general path returns, bit for bit; None when the call is not of the plain kind
         described in the module notes (or has an invalid input: the general path raises its error).
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers.quick import quick_solve
+    >>> tr = quick_solve([1.0, 2.0, 3.0], [0.0, 1.0], omega0=[1.0, 0.1, 0.5])
+    >>> tr.method, tr.omega.shape
+    ('exact', (2, 3))
+    >>> quick_solve([1.0, 2.0, 3.0], [0.0, 1.0], m0=[1.0, 0.1, 0.5]) is None  # not of the plain kind
+    True
     """
     start = _time.perf_counter()
     if torque is not None or m0 is not None or gibbs0 is not None or workers is not None or omega0 is None:

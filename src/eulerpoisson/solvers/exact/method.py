@@ -71,9 +71,14 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
 
     if problem.t.size == 0:
         return
-    tmax = float(np.max(np.abs(problem.t)))
+    tmax = float(np.abs(problem.t).max())
     if speed is None:
         w = problem.omega0
+        if w.ndim == 1:  # one body (plain floats)
+            a, b, c = w.tolist()
+            wmax = max(abs(a), abs(b), abs(c))
+            if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
+                return
         # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
         wmax = max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
         if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
@@ -244,7 +249,7 @@ class Exact(Method):
         return MethodResult(
             q=q,
             omega=omega,
-            stats={"evaluations": int(np.prod(q.shape[:-1])), "compiled": bool(path == "compiled" and _numba_in_use())},
+            stats={"evaluations": math.prod(q.shape[:-1]), "compiled": path == "compiled" and jit.USE_NUMBA},
         )
 
     def work_estimate(self, problem: Problem) -> float:

@@ -860,7 +860,6 @@ def _kernel_array(x):
 def _exact_motion_compiled(inertia, M0, t, python=False):
     """Compiled path of :func:`exact_motion` (``t`` already validated); ``python``: the scalar kernel as plain
     Python (the same numbers: the lane kernel and the scalar one agree bit for bit, and so do their twins)."""
-    from ...util.jit import python_twins
     from . import kernels as _K
 
     inertia, M0, batch = _validate(inertia, M0)
@@ -871,6 +870,8 @@ def _exact_motion_compiled(inertia, M0, t, python=False):
     qout = np.empty((nb, T, 4))
     if nb and T:
         if python:
+            from ...util.jit import python_twins
+
             with python_twins():
                 _K.motion_kernel_scalar(inertia, M0, t, Mout, qout)
         else:

@@ -1212,6 +1212,10 @@ def _kernel_array(x):
     type of its own: every array passed to the kernels goes through here, so
     that each kernel has one signature (the one ``eulerpoisson warmup`` compiles).
     """
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        f = x.flags
+        if f.c_contiguous and f.aligned and f.writeable:
+            return x
     return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
 
 

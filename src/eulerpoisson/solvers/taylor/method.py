@@ -412,9 +412,10 @@ def integrate_principal(
         raise InvalidInputError("moments, omega0 and q0 must be 1-D (one body) or 2-D (B bodies)")
     B = max(np.atleast_2d(m).shape[0], np.atleast_2d(w).shape[0], np.atleast_2d(qa).shape[0])
     try:
-        m2 = np.broadcast_to(np.atleast_2d(m), (B, 3))
-        w2 = np.broadcast_to(np.atleast_2d(w), (B, 3))
-        q2 = np.broadcast_to(np.atleast_2d(qa), (B, 4))
+        m2, w2, q2 = (
+            a2 if a2.shape == shape else np.broadcast_to(a2, shape)
+            for a2, shape in ((np.atleast_2d(m), (B, 3)), (np.atleast_2d(w), (B, 3)), (np.atleast_2d(qa), (B, 4)))
+        )
     except ValueError as exc:
         raise InvalidInputError(
             f"moments {m.shape}, omega0 {w.shape} and q0 {qa.shape} do not broadcast to one batch"

@@ -220,7 +220,8 @@ class Exact(Method):
         return planned
 
     def run(self, problem: Problem) -> MethodResult:
-        from .motion import exact_motion
+        # (the problem is checked: float64, finite, moments > 0; the kernels need no second check)
+        from .motion import exact_motion_unchecked as exact_motion
 
         if not problem.model.is_free:
             return self._run_lagrange(problem)

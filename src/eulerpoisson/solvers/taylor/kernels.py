@@ -1241,10 +1241,14 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     """
     moments, w0, qref0, t = (_kernel_array(x) for x in (moments, w0, qref0, t))  # (one signature per kernel)
     B, T = moments.shape[0], t.shape[0]
-    pos = np.flatnonzero(t >= 0)
-    pos = np.ascontiguousarray(pos[np.argsort(t[pos], kind="stable")], dtype=np.int64)
-    neg = np.flatnonzero(t < 0)
-    neg = np.ascontiguousarray(neg[np.argsort(-t[neg], kind="stable")], dtype=np.int64)
+    if T == 1:  # one output time: the orderings below without the sorting
+        one, none = np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)
+        pos, neg = (one, none) if t[0] >= 0 else (none, one)
+    else:
+        pos = np.flatnonzero(t >= 0)
+        pos = np.ascontiguousarray(pos[np.argsort(t[pos], kind="stable")], dtype=np.int64)
+        neg = np.flatnonzero(t < 0)
+        neg = np.ascontiguousarray(neg[np.argsort(-t[neg], kind="stable")], dtype=np.int64)
     q_out = np.zeros((B, T, 4))
     w_out = np.zeros((B, T, 3))
     stats = np.zeros((B, 3), dtype=np.int64)

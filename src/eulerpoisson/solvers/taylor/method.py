@@ -444,11 +444,39 @@ def integrate_principal(
     if not generic:
         if np.any(m2 <= 0):
             raise InvalidInputError(f"moments must be > 0, got {m.tolist()}")
+    q, om, stats = _integrate_checked(m2, w2, q2, ta, tol, order, dt, max_steps, chart_threshold, use_numba, lanes)
+    if single:
+        return q[0], om[0], stats
+    return q, om, stats
+
+
+def _integrate_checked(m2, w2, q2, ta, tol, order, dt, max_steps, chart_threshold, use_numba, lanes):
+    """:func:`integrate_principal` after its checks: ``(q, omega, stats)`` of the batch (B bodies).
+
+    The arrays are (B, 3), (B, 3), (B, 4) and (T,); the options normalized (``order`` an int, ``tol``,
+    ``dt`` (or None) and ``chart_threshold`` floats, ``max_steps`` an int).
+
+    Raises
+    ------
+    EulerPoissonError
+        ``max_steps`` exhausted, or a non-finite state (a diverging series).
+    """
     kw = dict(tol=tol, order=order, dt=dt, max_steps=max_steps, threshold=chart_threshold)
+    B = m2.shape[0]
     if use_numba:
         q, om, st = _k.integrate_numba(m2, w2, q2, ta, lanes=lanes, **kw)
     else:
         q, om, st = _k.integrate_numpy(m2, w2, q2, ta, **kw)
+    if B == 1:  # one body: its counters as plain ints (the same numbers, fewer array reductions)
+        steps, charts, code = st[0].tolist()
+        if code != _k.STATUS_MAX_STEPS and code != _k.STATUS_NONFINITE:
+            return q, om, {
+                "steps": steps,
+                "steps_max": steps,
+                "chart_changes": charts,
+                "max_order": int(order),
+                "backend": "numba" if use_numba else "numpy",
+            }
     status = st[:, 2]
     if np.any(status == _k.STATUS_MAX_STEPS):
         b = int(np.flatnonzero(status == _k.STATUS_MAX_STEPS)[0])
@@ -466,8 +494,6 @@ def integrate_principal(
         "max_order": int(order),
         "backend": "numba" if use_numba else "numpy",
     }
-    if single:
-        return q[0], om[0], stats
     return q, om, stats
 
 
@@ -672,18 +698,37 @@ class Taylor(Method):
             w0p = np.einsum("bji,bj->bi", P, w0)
             qP = quaternion_from_rotation_matrix(P)
             qref0 = qmul(q0, qP)
-        q, om, stats = integrate_principal(
-            moments,
-            w0p,
-            problem.t,
-            q0=qref0,
-            tol=c["tol"],
-            order=c["order"],
-            dt=c["dt"],
-            max_steps=c["max_steps"],
-            chart_threshold=c["chart_threshold"],
-            lanes=self._lanes,
-        )
+        if _k.USE_NUMBA:
+            # the options were checked with the method, the arrays with the problem (integrate_principal's checks)
+            dt = c["dt"]
+            tol = float(c["tol"])
+            order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
+            q, om, stats = _integrate_checked(
+                moments,
+                w0p,
+                qref0,
+                problem.t,
+                tol,
+                int(order),
+                None if dt is None else float(dt),
+                int(c["max_steps"]),
+                float(c["chart_threshold"]),
+                True,
+                self._lanes,
+            )
+        else:
+            q, om, stats = integrate_principal(
+                moments,
+                w0p,
+                problem.t,
+                q0=qref0,
+                tol=c["tol"],
+                order=c["order"],
+                dt=c["dt"],
+                max_steps=c["max_steps"],
+                chart_threshold=c["chart_threshold"],
+                lanes=self._lanes,
+            )
         if not diagonal:
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
             q = qmul(q, qPc[:, None, :])

@@ -103,22 +103,29 @@ def numpy_below() -> float:
 _RUN: contextvars.ContextVar[tuple[int, int]] = contextvars.ContextVar("eulerpoisson_whole_run", default=(0, 0))
 
 
-@contextlib.contextmanager
-def whole_run(n_bodies: int = 0, n_times: int = 0) -> Iterator[None]:
+class whole_run:
     """Within it, every problem solved is a part of one run of ``n_bodies`` bodies at ``n_times`` output times.
 
-    The methods choose between their compiled kernels and NumPy from the
-    size of the whole run (:func:`run_shape`), not of the part: a run solved
-    in chunks (the command line's and :func:`~eulerpoisson.io.stream.solve_to_file`'s
+    A context manager (``with whole_run(B, T): ...``). The methods choose
+    between their compiled kernels and NumPy from the size of the whole run
+    (:func:`run_shape`), not of the part: a run solved in chunks (the
+    command line's and :func:`~eulerpoisson.io.stream.solve_to_file`'s
     chunks of output times, a sweep's chunks of points) takes one path in
     every chunk, which gives the numbers of one call and pays numba's start
-    once for a large run. 0: the part's own size.
+    once for a large run. 0: the part's own size. (A class rather than a
+    generator: it is entered on every call of ``solve``.)
     """
-    token = _RUN.set((int(n_bodies), int(n_times)))
-    try:
-        yield
-    finally:
-        _RUN.reset(token)
+
+    __slots__ = ("_shape", "_token")
+
+    def __init__(self, n_bodies: int = 0, n_times: int = 0) -> None:
+        self._shape = (int(n_bodies), int(n_times))
+
+    def __enter__(self) -> None:
+        self._token = _RUN.set(self._shape)
+
+    def __exit__(self, *exc: object) -> None:
+        _RUN.reset(self._token)
 
 
 def run_shape(n_bodies: int, n_times: int) -> tuple[int, int]:

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...attitude.core import quaternion_from_rotation_matrix
+from ...errors import InvalidInputError
 from ...numerics.quaternion import qmul
 from ...util import jit
 from ..problem import Problem, compose_initial
@@ -67,18 +68,18 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
         (``speed`` replaces :math:`|\boldsymbol\Omega_0|` when given: a
         heavy top's rate includes :math:`\sqrt{\mu g\ell/A}`).
     """
-    from ...errors import InvalidInputError
-
     if problem.t.size == 0:
         return
+    if speed is None and problem.omega0.ndim == 1 and problem.t.size <= 16:
+        # one body at a few times (plain floats): the common case below
+        a, b, c = problem.omega0.tolist()
+        wmax = max(abs(a), abs(b), abs(c))
+        tmax = max(abs(x) for x in problem.t.tolist())
+        if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
+            return
     tmax = float(np.abs(problem.t).max())
     if speed is None:
         w = problem.omega0
-        if w.ndim == 1:  # one body (plain floats)
-            a, b, c = w.tolist()
-            wmax = max(abs(a), abs(b), abs(c))
-            if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
-                return
         # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
         wmax = max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
         if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
@@ -310,7 +311,12 @@ _IDENTITY9 = np.eye(3).reshape(9)
 
 def _all_identity(frames) -> bool:
     """Whether every 3x3 matrix of ``frames`` (shape ``(..., 3, 3)``) is the identity, exactly."""
+    if np.ndim(frames) == 2:  # one matrix: plain floats
+        return np.ravel(frames).tolist() == _IDENTITY9_LIST
     return bool((np.reshape(frames, (-1, 9)) == _IDENTITY9).all())
+
+
+_IDENTITY9_LIST = _IDENTITY9.tolist()
 
 
 def _principal_frame(problem: Problem) -> bool:

@@ -154,6 +154,7 @@ from ...errors import InvalidInertiaError, InvalidInputError
 from ...numerics import elliptic as _el
 from ...numerics.doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, two_prod, two_sum
 from ...numerics.quaternion import qmul_components
+from ...util import jit as _jit
 
 __all__ = [
     "ExactMotion",
@@ -850,9 +851,20 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
 
 
 def _use_numba() -> bool:
-    from ...util.jit import USE_NUMBA
+    return _jit.USE_NUMBA
 
-    return USE_NUMBA
+
+def _kernels():
+    """The kernels module (imported on first use: the NumPy path never needs it)."""
+    global _KERNELS
+    if _KERNELS is None:
+        from . import kernels
+
+        _KERNELS = kernels
+    return _KERNELS
+
+
+_KERNELS = None
 
 
 def _kernel_array(x):
@@ -896,17 +908,14 @@ def _exact_motion_compiled(inertia, M0, t, python=False):
 
 def _run_kernel(inertia, M0, t, batch, python):
     """The compiled kernel (or its plain-Python twin) on kernel arrays ``(nb, 3)``, ``(nb, 3)``, ``(T,)``."""
-    from . import kernels as _K
-
+    _K = _kernels()
     nb = inertia.shape[0]
     T = t.shape[0]
     Mout = np.empty((nb, T, 3))
     qout = np.empty((nb, T, 4))
     if nb and T:
         if python:
-            from ...util.jit import python_twins
-
-            with python_twins():
+            with _jit.python_twins():
                 _K.motion_kernel_scalar(inertia, M0, t, Mout, qout)
         else:
             _K.motion_kernel(inertia, M0, t, Mout, qout)

@@ -470,13 +470,17 @@ def _integrate_checked(m2, w2, q2, ta, tol, order, dt, max_steps, chart_threshol
     if B == 1:  # one body: its counters as plain ints (the same numbers, fewer array reductions)
         steps, charts, code = st[0].tolist()
         if code != _k.STATUS_MAX_STEPS and code != _k.STATUS_NONFINITE:
-            return q, om, {
-                "steps": steps,
-                "steps_max": steps,
-                "chart_changes": charts,
-                "max_order": int(order),
-                "backend": "numba" if use_numba else "numpy",
-            }
+            return (
+                q,
+                om,
+                {
+                    "steps": steps,
+                    "steps_max": steps,
+                    "chart_changes": charts,
+                    "max_order": int(order),
+                    "backend": "numba" if use_numba else "numpy",
+                },
+            )
     status = st[:, 2]
     if np.any(status == _k.STATUS_MAX_STEPS):
         b = int(np.flatnonzero(status == _k.STATUS_MAX_STEPS)[0])

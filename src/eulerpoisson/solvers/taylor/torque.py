@@ -192,10 +192,12 @@ def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
     + \boldsymbol\tau_0\big) + M\mathbf v` with :math:`M = I^{-1}L` (made once per body),
     :math:`\dot{\mathbf v} = \mathbf v\times\boldsymbol\Omega`,
     :math:`\dot q = \frac12 q\otimes(0, \boldsymbol\Omega)`: :func:`_coefficients` without its
-    branches and its loops over Poisson vectors. Each order runs the closed (Omega, v) recurrence
-    first (the critical path: the next order needs it) and the q sums after (independent work that
-    overlaps it); 1/(k + 1) is multiplied, not divided. Row 0 of Q, W and V (one vector: shape
-    (order + 1, 3)) is set.
+    branches and its loops over Poisson vectors. The three Cauchy sums of an order run in one loop
+    over j (each row of W loaded once), and every product is added to its sum on its own
+    (``g += a * b`` then ``g -= c * d``), which ``contract`` fuses into one multiply-add each: 24
+    fused operations per term instead of 34 (a product, a fused product and an addition per
+    two-term component); 1/(k + 1) is multiplied, not divided. Row 0 of Q, W and V (one vector:
+    shape (order + 1, 3)) is set.
     """
     for k in range(order):
         # M_k = I W_k
@@ -205,13 +207,17 @@ def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
         MI[k, 0] = I[0, 0] * x0 + I[0, 1] * x1 + I[0, 2] * x2
         MI[k, 1] = I[1, 0] * x0 + I[1, 1] * x1 + I[1, 2] * x2
         MI[k, 2] = I[2, 0] * x0 + I[2, 1] * x1 + I[2, 2] * x2
-        # (I Omega) x Omega and v x Omega
         g0 = 0.0
         g1 = 0.0
         g2 = 0.0
         c0 = 0.0
         c1 = 0.0
         c2 = 0.0
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        s3 = 0.0
+        # (I Omega) x Omega, v x Omega and q (x) (0, Omega), one loop
         for j in range(k + 1):
             m = k - j
             w0 = W[m, 0]
@@ -220,15 +226,37 @@ def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
             m0 = MI[j, 0]
             m1 = MI[j, 1]
             m2 = MI[j, 2]
-            g0 += m1 * w2 - m2 * w1
-            g1 += m2 * w0 - m0 * w2
-            g2 += m0 * w1 - m1 * w0
+            g0 += m1 * w2
+            g0 -= m2 * w1
+            g1 += m2 * w0
+            g1 -= m0 * w2
+            g2 += m0 * w1
+            g2 -= m1 * w0
             v0 = V[j, 0]
             v1 = V[j, 1]
             v2 = V[j, 2]
-            c0 += v1 * w2 - v2 * w1
-            c1 += v2 * w0 - v0 * w2
-            c2 += v0 * w1 - v1 * w0
+            c0 += v1 * w2
+            c0 -= v2 * w1
+            c1 += v2 * w0
+            c1 -= v0 * w2
+            c2 += v0 * w1
+            c2 -= v1 * w0
+            pw = Q[j, 0]
+            px = Q[j, 1]
+            py = Q[j, 2]
+            pz = Q[j, 3]
+            s0 -= px * w0
+            s0 -= py * w1
+            s0 -= pz * w2
+            s1 += pw * w0
+            s1 += py * w2
+            s1 -= pz * w1
+            s2 += pw * w1
+            s2 -= px * w2
+            s2 += pz * w0
+            s3 += pw * w2
+            s3 += px * w1
+            s3 -= py * w0
         if k == 0:
             g0 += tau0[0]
             g1 += tau0[1]
@@ -244,24 +272,6 @@ def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
         V[k + 1, 0] = c0 * inv
         V[k + 1, 1] = c1 * inv
         V[k + 1, 2] = c2 * inv
-        # q (x) (0, Omega): four dot products
-        s0 = 0.0
-        s1 = 0.0
-        s2 = 0.0
-        s3 = 0.0
-        for j in range(k + 1):
-            m = k - j
-            w0 = W[m, 0]
-            w1 = W[m, 1]
-            w2 = W[m, 2]
-            pw = Q[j, 0]
-            px = Q[j, 1]
-            py = Q[j, 2]
-            pz = Q[j, 3]
-            s0 += -px * w0 - py * w1 - pz * w2
-            s1 += pw * w0 + py * w2 - pz * w1
-            s2 += pw * w1 - px * w2 + pz * w0
-            s3 += pw * w2 + px * w1 - py * w0
         hinv = 0.5 * inv
         Q[k + 1, 0] = s0 * hinv
         Q[k + 1, 1] = s1 * hinv

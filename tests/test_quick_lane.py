@@ -212,6 +212,9 @@ I[k : k + 6] = Is
 d = np.array([-1e-12, 1e-12, -1e-9, 1e-9, -1e-6, 1e-6])
 r = np.sqrt(((Is[:, 1] - Is[:, 0]) / Is[:, 0]) / ((Is[:, 2] - Is[:, 1]) / Is[:, 2]))
 M0[k : k + 6] = np.stack([np.ones(6), 1e-3 * np.ones(6), r * (1.0 + d)], axis=-1)
+M0[-1] = 0.0                                         # at rest
+M0[-2] = [1e-310, 2e-310, -3e-310]                    # subnormal momenta
+M0[-3] = [1e6, -3e5, 2e6]                             # large ones (|Omega| t within 2^48)
 t = np.concatenate([[0.0, 1e-9, 1e-3, 1.0, -3.0, 77.7, 1e4], rng.uniform(-500.0, 500.0, 6)])
 """
 

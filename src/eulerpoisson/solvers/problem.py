@@ -89,7 +89,12 @@ class Problem:
 
     @property
     def principal_axes(self) -> np.ndarray:
-        return np.broadcast_to(self.body.principal_axes, self.batch_shape + (3, 3))
+        pa = self.body.principal_axes
+        if pa.shape[:-2] == self.batch_shape:  # no broadcast needed: a read-only view, as broadcast_to gives
+            view = pa.view()
+            view.flags.writeable = False
+            return view
+        return np.broadcast_to(pa, self.batch_shape + (3, 3))
 
     @property
     def M0(self) -> np.ndarray:

@@ -146,6 +146,7 @@ References
 
 from __future__ import annotations
 
+from types import ModuleType
 from typing import NamedTuple
 
 import numpy as np
@@ -864,7 +865,7 @@ def _kernels():
     return _KERNELS
 
 
-_KERNELS = None
+_KERNELS: ModuleType | None = None
 
 
 def _kernel_array(x):

@@ -1236,8 +1236,8 @@ def _kernel_array(x):
     """
     if type(x) is np.ndarray and x.dtype == np.float64:
         f = x.flags
-        if f.c_contiguous and f.aligned and f.writeable:
-            return x
+        if f.c_contiguous and f.aligned:
+            return x if f.writeable else x.copy()
     return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
 
 

@@ -84,6 +84,7 @@ Anwendungen* (1960). A. Griewank and A. Walther, *Evaluating Derivatives*,
 
 from __future__ import annotations
 
+import math
 import numbers
 from contextlib import nullcontext as _nullcontext
 from dataclasses import dataclass
@@ -656,7 +657,7 @@ class Taylor(Method):
         import copy
 
         planned = copy.copy(self)
-        planned._lanes = int(np.prod(problem.batch_shape, dtype=int)) >= _k.LANES_MIN_BODIES
+        planned._lanes = math.prod(problem.batch_shape) >= _k.LANES_MIN_BODIES
         return planned
 
     def work_estimate(self, problem: Problem) -> float:
@@ -688,7 +689,7 @@ class Taylor(Method):
             return self._run_torque(problem)
         c = self.config
         bshape = problem.batch_shape
-        B = int(np.prod(bshape)) if bshape else 1
+        B = math.prod(bshape)
         moments = np.ascontiguousarray(problem.principal_moments).reshape(B, 3)
         P = np.ascontiguousarray(problem.principal_axes).reshape(B, 3, 3)
         w0 = problem.extended.get("omega0", problem.omega0).reshape(B, 3)

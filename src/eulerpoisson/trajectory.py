@@ -197,7 +197,7 @@ class Trajectory:
         if not isinstance(method, str):
             raise TypeError(f"method must be a string, got {type(method).__name__} {method!r}")
         for nm, val in (("options", options), ("stats", stats)):
-            if val is not None and not isinstance(val, Mapping):
+            if val is not None and type(val) is not dict and not isinstance(val, Mapping):
                 raise TypeError(f"{nm} must be a dict (or None), got {type(val).__name__} {val!r}")
         if _prepared:
             q = np.asarray(quaternion, dtype=np.float64)

@@ -31,6 +31,7 @@ Comput. 30 (2008) 2084-2112.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 
@@ -209,8 +210,6 @@ class Exact(Method):
 
     def for_batch(self, problem: Problem) -> Exact:
         """This method with the batch-wide choices made: compiled kernels or NumPy (:meth:`numpy_estimate`), principal frame."""
-        import copy
-
         planned = copy.copy(self)
         if problem.model.is_free:
             planned._path = self._free_path(problem)

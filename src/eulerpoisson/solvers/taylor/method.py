@@ -703,37 +703,23 @@ class Taylor(Method):
             w0p = np.einsum("bji,bj->bi", P, w0)
             qP = quaternion_from_rotation_matrix(P)
             qref0 = qmul(q0, qP)
-        if _k.USE_NUMBA:
-            # the options were checked with the method, the arrays with the problem (integrate_principal's checks)
-            dt = c["dt"]
-            tol = float(c["tol"])
-            order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
-            q, om, stats = _integrate_checked(
-                moments,
-                w0p,
-                qref0,
-                problem.t,
-                tol,
-                int(order),
-                None if dt is None else float(dt),
-                int(c["max_steps"]),
-                float(c["chart_threshold"]),
-                True,
-                self._lanes,
-            )
-        else:
-            q, om, stats = integrate_principal(
-                moments,
-                w0p,
-                problem.t,
-                q0=qref0,
-                tol=c["tol"],
-                order=c["order"],
-                dt=c["dt"],
-                max_steps=c["max_steps"],
-                chart_threshold=c["chart_threshold"],
-                lanes=self._lanes,
-            )
+        # the options were checked with the method, the arrays with the problem (integrate_principal's checks)
+        dt = c["dt"]
+        tol = float(c["tol"])
+        order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
+        q, om, stats = _integrate_checked(
+            moments,
+            w0p,
+            qref0,
+            problem.t,
+            tol,
+            int(order),
+            None if dt is None else float(dt),
+            int(c["max_steps"]),
+            float(c["chart_threshold"]),
+            bool(_k.USE_NUMBA),
+            self._lanes,
+        )
         if not diagonal:
             qPc = qP * np.array([1.0, -1.0, -1.0, -1.0])
             q = qmul(q, qPc[:, None, :])

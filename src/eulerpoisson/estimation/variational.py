@@ -49,7 +49,7 @@ import math
 
 import numpy as np
 
-from ..util.jit import USE_NUMBA
+from ..util.jit import USE_NUMBA, kernel_array
 
 __all__ = ["propagate", "Sensitivities"]
 
@@ -88,12 +88,6 @@ def _order(tol):
     return int(math.ceil(-0.5 * math.log(tol) + 1.0))
 
 
-def _kernel_array(x):
-    """Writeable, C-contiguous float64 (copied only where needed: a read-only or strided array would compile a
-    second specialization of the kernel)."""
-    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
-
-
 def propagate(inertia, omega0, dinertia, tau, *, tol: float = 2.0**-52) -> Sensitivities:
     r"""Integrate the motion and its variational equations to the times ``tau``.
 
@@ -120,11 +114,11 @@ def propagate(inertia, omega0, dinertia, tau, *, tol: float = 2.0**-52) -> Sensi
     FloatingPointError
         The motion became non-finite or needed more than ``MAX_STEPS`` steps.
     """
-    inertia = _kernel_array(inertia)
-    jinv = _kernel_array(np.linalg.inv(inertia))
-    omega0 = _kernel_array(omega0)
-    dinertia = _kernel_array(np.asarray(dinertia, dtype=np.float64).reshape(-1, 3, 3))
-    tau = _kernel_array(tau)
+    inertia = kernel_array(inertia)
+    jinv = kernel_array(np.linalg.inv(inertia))
+    omega0 = kernel_array(omega0)
+    dinertia = kernel_array(np.asarray(dinertia, dtype=np.float64).reshape(-1, 3, 3))
+    tau = kernel_array(tau)
     order = _order(tol)
     safety = math.exp(-0.7 / (order - 1))
     K = tau.shape[0]

@@ -80,26 +80,26 @@ class Problem:
 
     @property
     def principal_moments(self) -> np.ndarray:
-        pm = self.body.principal_moments
-        if pm.shape[:-1] == self.batch_shape:  # no broadcast needed: a read-only view, as broadcast_to gives
-            view = pm.view()
-            view.flags.writeable = False
-            return view
-        return np.broadcast_to(pm, self.batch_shape + (3,))
+        return _read_only_to(self.body.principal_moments, self.batch_shape + (3,))
 
     @property
     def principal_axes(self) -> np.ndarray:
-        pa = self.body.principal_axes
-        if pa.shape[:-2] == self.batch_shape:  # no broadcast needed: a read-only view, as broadcast_to gives
-            view = pa.view()
-            view.flags.writeable = False
-            return view
-        return np.broadcast_to(pa, self.batch_shape + (3, 3))
+        return _read_only_to(self.body.principal_axes, self.batch_shape + (3, 3))
 
     @property
     def M0(self) -> np.ndarray:
         """Initial body angular momentum, ``(*batch_shape, 3)``."""
         return np.einsum("...ij,...j->...i", self.inertia, self.omega0)
+
+
+def _read_only_to(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``np.broadcast_to(a, shape)`` (a read-only view); a plain read-only view where ``a`` has that shape already
+    (what the methods of one body read, without broadcast_to's cost)."""
+    if a.shape != shape:
+        return np.broadcast_to(a, shape)
+    view = a.view()
+    view.flags.writeable = False
+    return view
 
 
 def _as_times(t) -> np.ndarray:

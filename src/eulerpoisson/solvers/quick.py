@@ -125,7 +125,7 @@ def _body(body: Any) -> RigidBody | None:
         return None
     try:
         return cached_body((moments[0], moments[1], moments[2]))
-    except (TypeError, ValueError, InvalidInputError):
+    except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
         return None  # the general path raises it
 
 
@@ -193,7 +193,7 @@ def quick_solve(
     cls = type(m)
     try:
         check_supported(m, model)  # the configured method: its options count (a free-body-only scheme)
-    except (TypeError, ValueError, InvalidInputError):
+    except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
         return None
     tt = np.array(times)
     if not cls.negative_times and min(times) < 0:

@@ -32,6 +32,8 @@ import sys
 import threading
 from collections.abc import Iterator
 
+import numpy as np
+
 __all__ = [
     "USE_NUMBA",
     "NUMPY_BELOW",
@@ -49,6 +51,7 @@ __all__ = [
     "lazy_module",
     "jitable",
     "stack_buffer",
+    "kernel_array",
 ]
 
 
@@ -474,3 +477,27 @@ def jitable(f):
             else:
                 _PENDING_JITABLE.append((f, {}))
     return f
+
+
+def kernel_array(x):
+    """``x`` as a C-contiguous, aligned, writeable float64 ndarray (a copy only where it is not one already).
+
+    numba compiles one specialization per array type, and a read-only array
+    (``np.broadcast_to``, ``flags.writeable = False``, a NetCDF read) or a
+    strided one is a type of its own: every array passed to a compiled
+    kernel goes through here, so that each kernel has one signature (the one
+    ``eulerpoisson warmup`` compiles). The common case (already such an
+    array) costs two attribute reads.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> a = np.zeros(3)
+    >>> kernel_array(a) is a, kernel_array(np.broadcast_to(a, (2, 3))).flags.writeable
+    (True, True)
+    """
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        f = x.flags
+        if f.c_contiguous and f.aligned:
+            return x if f.writeable else x.copy()
+    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))

@@ -71,18 +71,16 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
     """
     if problem.t.size == 0:
         return
-    if speed is None and problem.omega0.ndim == 1 and problem.t.size <= 16:
-        # one body at a few times (plain floats): the common case below
-        a, b, c = problem.omega0.tolist()
-        wmax = max(abs(a), abs(b), abs(c))
-        tmax = max(abs(x) for x in problem.t.tolist())
-        if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
-            return
-    tmax = float(np.abs(problem.t).max())
+    w = problem.omega0
+    few = w.ndim == 1 and problem.t.size <= 16  # one body at a few times: the maxima in plain floats
+    tmax = max(abs(x) for x in problem.t.tolist()) if few else float(np.abs(problem.t).max())
     if speed is None:
-        w = problem.omega0
         # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
-        wmax = max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
+        wmax = (
+            max(abs(x) for x in w.tolist())
+            if few
+            else max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
+        )
         if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
             return
         w2 = np.sum(w * w, axis=-1)

@@ -840,19 +840,13 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise InvalidInputError(f"chunk_size must be a positive integer, got {chunk_size}")
-    from ...util.jit import USE_NUMBA  # (the kernels module is imported by the compiled path only)
-
     if isinstance(compiled, str):
         if compiled != "python":
             raise InvalidInputError(f"compiled must be True, False, None or 'python', got {compiled!r}")
         return _exact_motion_compiled(inertia, M0, t, python=True)
-    if USE_NUMBA and compiled is not False:
+    if _jit.USE_NUMBA and compiled is not False:
         return _exact_motion_compiled(inertia, M0, t)
     return _exact_motion_numpy(inertia, M0, t, chunk_size)
-
-
-def _use_numba() -> bool:
-    return _jit.USE_NUMBA
 
 
 def _kernels():
@@ -866,15 +860,6 @@ def _kernels():
 
 
 _KERNELS: ModuleType | None = None
-
-
-def _kernel_array(x):
-    """C-contiguous, aligned, writeable float64 (one compiled signature per kernel)."""
-    if type(x) is np.ndarray and x.dtype == np.float64:
-        f = x.flags
-        if f.c_contiguous and f.aligned:
-            return x if f.writeable else x.copy()
-    return np.require(x, dtype=np.float64, requirements=["C_CONTIGUOUS", "ALIGNED", "WRITEABLE"])
 
 
 def exact_motion_unchecked(inertia, M0, t, *, compiled):
@@ -893,10 +878,10 @@ def exact_motion_unchecked(inertia, M0, t, *, compiled):
     >>> bool(np.array_equal(a.q, b.q) and np.array_equal(a.M, b.M))
     True
     """
-    if isinstance(compiled, str) or (compiled is not False and _use_numba()):
+    if isinstance(compiled, str) or (compiled is not False and _jit.USE_NUMBA):
         batch = inertia.shape[:-1]
-        I2, M2 = _kernel_array(inertia.reshape(-1, 3)), _kernel_array(M0.reshape(-1, 3))
-        return _run_kernel(I2, M2, _kernel_array(t), batch, python=isinstance(compiled, str))
+        I2, M2 = _jit.kernel_array(inertia.reshape(-1, 3)), _jit.kernel_array(M0.reshape(-1, 3))
+        return _run_kernel(I2, M2, _jit.kernel_array(t), batch, python=isinstance(compiled, str))
     return _exact_motion_numpy(inertia, M0, t)
 
 
@@ -904,7 +889,7 @@ def _exact_motion_compiled(inertia, M0, t, python=False):
     """Compiled path of :func:`exact_motion` (``t`` already validated); ``python``: the scalar kernel as plain
     Python (the same numbers: the lane kernel and the scalar one agree bit for bit, and so do their twins)."""
     inertia, M0, batch = _validate(inertia, M0)
-    return _run_kernel(_kernel_array(inertia), _kernel_array(M0), _kernel_array(t), batch, python)
+    return _run_kernel(_jit.kernel_array(inertia), _jit.kernel_array(M0), _jit.kernel_array(t), batch, python)
 
 
 def _run_kernel(inertia, M0, t, batch, python):
@@ -1013,7 +998,7 @@ def _exact_constants_compiled(inertia, M0):
     from . import kernels as _K
 
     inertia, M0, batch = _validate(inertia, M0)
-    inertia, M0 = _kernel_array(inertia), _kernel_array(M0)
+    inertia, M0 = _jit.kernel_array(inertia), _jit.kernel_array(M0)
     out = np.empty((inertia.shape[0], 7))
     if inertia.shape[0]:
         _K.constants_kernel(inertia, M0, out)

@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from ...numerics.quaternion import qmul_components, rotate_inverse
-from ...util.jit import USE_NUMBA
+from ...util.jit import USE_NUMBA, kernel_array
 from ..exact import kernels as _ek
 
 free_flow = _ek.free_flow
@@ -146,15 +146,6 @@ if USE_NUMBA:  # pragma: no branch
     split_body = _njit(cache=True, nogil=True)(split_body)
 
 
-def _kernel_array(x):
-    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
-
-    numba compiles one specialization per array type, and a read-only array
-    (``np.broadcast_to``, ``flags.writeable = False``) is a type of its own.
-    """
-    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
-
-
 def run_exact_splitting(moments, qp0, Mp0, data, t, dt, order):
     """Integrate a batch in the principal frame.
 
@@ -178,7 +169,7 @@ def run_exact_splitting(moments, qp0, Mp0, data, t, dt, order):
     c, d = composition(order)
     # C-contiguous writeable float64 (a copy only where needed: the moments of one body are a read-only broadcast
     # view): one signature of split_body, the one the warm-up compiles
-    moments, qp0, Mp0, tau0, S, L = (_kernel_array(x) for x in (moments, qp0, Mp0, data.tau0, data.S, data.L))
+    moments, qp0, Mp0, tau0, S, L = (kernel_array(x) for x in (moments, qp0, Mp0, data.tau0, data.S, data.L))
     B = qp0.shape[0]
     T = t.shape[0]
     qout = np.empty((B, T, 4))
@@ -193,7 +184,7 @@ def run_exact_splitting(moments, qp0, Mp0, data, t, dt, order):
             if not idx.size:
                 continue
             oi = idx[np.argsort(np.abs(t[idx]), kind="stable")]
-            ts = _kernel_array(t[oi])
+            ts = kernel_array(t[oi])
             qo = np.empty((ts.shape[0], 4))
             Mo = np.empty((ts.shape[0], 3))
             steps += split_body(

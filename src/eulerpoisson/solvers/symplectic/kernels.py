@@ -89,7 +89,7 @@ __all__ = [
 ]
 
 
-from ...util.jit import USE_NUMBA  # numba importable and EULERPOISSON_NO_NUMBA not "1"
+from ...util.jit import USE_NUMBA, kernel_array  # numba importable and EULERPOISSON_NO_NUMBA not "1"
 
 #: bodies advanced in lockstep by the splitting kernel and by the Gauss kernel
 LANES_SPLITTING = 16
@@ -668,18 +668,11 @@ if USE_NUMBA:  # pragma: no branch
 # ---------------------------------------------------------------------------
 # entry points
 # ---------------------------------------------------------------------------
-def _kernel_array(x):
-    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
-
-    numba compiles one specialization per array type, and a read-only array
-    (``np.broadcast_to``, ``flags.writeable = False``) is a type of its own.
-    """
-    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
 
 
 def sincos_compiled(x):
     """:math:`(\\sin x, \\cos x)` by the compiled kernel (float64, 1-D); for tests."""
-    x = _kernel_array(np.ravel(x))
+    x = kernel_array(np.ravel(x))
     s = np.empty_like(x)
     c = np.empty_like(x)
     _nb_sincos_array(x, s, c)
@@ -716,9 +709,9 @@ def run_splitting(q0, M0, inv_m, sequence, t, dt):
     q_out = np.empty((B, T, 4))
     w_out = np.empty((B, T, 3))
     nb_splitting(
-        _kernel_array(q0),
-        _kernel_array(M0),
-        _kernel_array(inv_m),
+        kernel_array(q0),
+        kernel_array(M0),
+        kernel_array(inv_m),
         axes,
         fracs,
         h,
@@ -767,8 +760,8 @@ def run_gauss_quaternion(y0, inv_m, tableau, t, dt, max_iter):
     iters = np.zeros((B, 2), dtype=np.int64)
     status = np.zeros(4)
     nb_gauss(
-        _kernel_array(y0),
-        _kernel_array(inv_m),
+        kernel_array(y0),
+        kernel_array(inv_m),
         A,
         b,
         E,

@@ -86,7 +86,11 @@ import numpy as np
 from ...model.free_body import euler_coefficients
 from ...numerics.doubledouble import two_sum
 from ...numerics.quaternion import qmul_components
-from ...util.jit import USE_NUMBA, stack_buffer  # USE_NUMBA: numba importable, EULERPOISSON_NO_NUMBA not "1"
+from ...util.jit import (  # USE_NUMBA: numba importable, EULERPOISSON_NO_NUMBA not "1"
+    USE_NUMBA,
+    kernel_array,
+    stack_buffer,
+)
 
 __all__ = [
     "USE_NUMBA",
@@ -1226,27 +1230,12 @@ if USE_NUMBA:  # pragma: no branch
     nb_integrate_lanes = _njit(cache=True, nogil=True, fastmath={"contract"})(nb_integrate_lanes)
 
 
-def _kernel_array(x):
-    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
-
-    numba compiles one specialization per array type, and a read-only array
-    (``np.broadcast_to``, ``flags.writeable = False``, a NetCDF read) is a
-    type of its own: every array passed to the kernels goes through here, so
-    that each kernel has one signature (the one ``eulerpoisson warmup`` compiles).
-    """
-    if type(x) is np.ndarray and x.dtype == np.float64:
-        f = x.flags
-        if f.c_contiguous and f.aligned:
-            return x if f.writeable else x.copy()
-    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
-
-
 def coefficients_numba(moments, n0, w0, order):
     """Taylor coefficients by the compiled kernel, (B, order+1, 3) each (float64).
 
     Runs the plain-Python version of the same code when numba is not used.
     """
-    return _nb_coefficients(_kernel_array(moments), _kernel_array(n0), _kernel_array(w0), int(order))
+    return _nb_coefficients(kernel_array(moments), kernel_array(n0), kernel_array(w0), int(order))
 
 
 def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, threshold, lanes=None):
@@ -1261,7 +1250,7 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     Runs the plain-Python version of the same code when numba is not used
     (slow; :func:`integrate_numpy` is the fallback actually used then).
     """
-    moments, w0, qref0, t = (_kernel_array(x) for x in (moments, w0, qref0, t))  # (one signature per kernel)
+    moments, w0, qref0, t = (kernel_array(x) for x in (moments, w0, qref0, t))  # (one signature per kernel)
     B, T = moments.shape[0], t.shape[0]
     if T == 1:  # one output time: the orderings below without the sorting
         one, none = np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)

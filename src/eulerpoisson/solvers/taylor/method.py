@@ -468,34 +468,27 @@ def _integrate_checked(m2, w2, q2, ta, tol, order, dt, max_steps, chart_threshol
         q, om, st = _k.integrate_numba(m2, w2, q2, ta, lanes=lanes, **kw)
     else:
         q, om, st = _k.integrate_numpy(m2, w2, q2, ta, **kw)
-    if B == 1:  # one body: its counters as plain ints (the same numbers, fewer array reductions)
-        steps, charts, code = st[0].tolist()
-        if code != _k.STATUS_MAX_STEPS and code != _k.STATUS_NONFINITE:
-            return (
-                q,
-                om,
-                {
-                    "steps": steps,
-                    "steps_max": steps,
-                    "chart_changes": charts,
-                    "max_order": int(order),
-                    "backend": "numba" if use_numba else "numpy",
-                },
-            )
     status = st[:, 2]
-    if np.any(status == _k.STATUS_MAX_STEPS):
-        b = int(np.flatnonzero(status == _k.STATUS_MAX_STEPS)[0])
-        raise EulerPoissonError(
-            f"taylor: max_steps={max_steps} exhausted (body {b}) before the last output time "
-            f"{float(np.max(np.abs(ta.astype(float)))):.6g}; raise max_steps (or tol, or dt)"
-        )
-    if np.any(status == _k.STATUS_NONFINITE):
-        b = int(np.flatnonzero(status == _k.STATUS_NONFINITE)[0])
-        raise EulerPoissonError(f"taylor: the state of body {b} became non-finite (diverging Taylor series)")
+    if status.any():  # a body failed (rare): name the first
+        if np.any(status == _k.STATUS_MAX_STEPS):
+            b = int(np.flatnonzero(status == _k.STATUS_MAX_STEPS)[0])
+            raise EulerPoissonError(
+                f"taylor: max_steps={max_steps} exhausted (body {b}) before the last output time "
+                f"{float(np.max(np.abs(ta.astype(float)))):.6g}; raise max_steps (or tol, or dt)"
+            )
+        if np.any(status == _k.STATUS_NONFINITE):
+            b = int(np.flatnonzero(status == _k.STATUS_NONFINITE)[0])
+            raise EulerPoissonError(f"taylor: the state of body {b} became non-finite (diverging Taylor series)")
+    if B == 1:  # one body: its counters as plain ints (the same numbers, fewer array reductions)
+        steps, charts, _ = st[0].tolist()
+        most = steps
+    else:
+        steps, charts = int(st[:, 0].sum()), int(st[:, 1].sum())
+        most = int(st[:, 0].max()) if B else 0
     stats = {
-        "steps": int(st[:, 0].sum()),
-        "steps_max": int(st[:, 0].max()) if B else 0,
-        "chart_changes": int(st[:, 1].sum()),
+        "steps": steps,
+        "steps_max": most,
+        "chart_changes": charts,
         "max_order": int(order),
         "backend": "numba" if use_numba else "numpy",
     }

@@ -50,7 +50,7 @@ import numpy as np
 
 from ...numerics.doubledouble import two_sum
 from ...numerics.quaternion import rotate_inverse
-from ...util.jit import USE_NUMBA
+from ...util.jit import USE_NUMBA, kernel_array
 
 __all__ = ["integrate_polynomial", "BACKEND"]
 
@@ -480,15 +480,6 @@ if USE_NUMBA:  # pragma: no branch
     integrate_body = _njit(cache=True, nogil=True, fastmath={"contract"})(integrate_body)
 
 
-def _kernel_array(x):
-    """``x`` as a C-contiguous, aligned, writeable float64 array (a copy only where it is not one already).
-
-    numba compiles one specialization per array type, and a read-only array
-    (``np.broadcast_to``, ``flags.writeable = False``) is a type of its own.
-    """
-    return np.require(x, dtype=np.float64, requirements=("C", "A", "W", "E"))
-
-
 def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps):
     """Integrate a batch of bodies under polynomial torques.
 
@@ -518,7 +509,7 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
     """
     # C-contiguous writeable float64 (a copy only where needed: the inertia is a broadcast view, read-only,
     # and so may be the torque's arrays): one signature of integrate_body, the one the warm-up compiles
-    inertia, q0, w0, tau0, S, L = (_kernel_array(x) for x in (inertia, q0, w0, data.tau0, data.S, data.L))
+    inertia, q0, w0, tau0, S, L = (kernel_array(x) for x in (inertia, q0, w0, data.tau0, data.S, data.L))
     B = q0.shape[0]
     T = t.shape[0]
     qout = np.empty((B, T, 4))
@@ -526,14 +517,14 @@ def integrate_polynomial(inertia, q0, w0, data, t, *, tol, order, dt, max_steps)
     status = np.zeros(B, dtype=np.int64)
     steps_total = 0
     steps_max = 0
-    Iinv = _kernel_array(np.linalg.inv(inertia)) if B else inertia
+    Iinv = kernel_array(np.linalg.inv(inertia)) if B else inertia
     pos = np.flatnonzero(t >= 0)
     neg = np.flatnonzero(t < 0)
     branches = []
     for idx in (pos, neg):
         if idx.size:
             order_idx = idx[np.argsort(np.abs(t[idx]), kind="stable")]
-            branches.append((order_idx, _kernel_array(t[order_idx])))
+            branches.append((order_idx, kernel_array(t[order_idx])))
     fixed = float(dt) if dt is not None else 0.0
     for b in range(B):
         used = 0

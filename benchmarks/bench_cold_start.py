@@ -1,4 +1,4 @@
-"""Cold and warm starts of the command line (issue 15): whole processes, end to end.
+"""Cold and warm starts of the command line (issues 15 and 25): whole processes, end to end.
 
 Every row is the wall time of a new process (``subprocess``, ``time.perf_counter`` around it),
 the best of several, in a temporary folder:
@@ -12,15 +12,23 @@ the best of several, in a temporary folder:
   from source at every start, as in a source tree where writing bytecode is disabled; not what an
   installed package does);
 * with a fresh, empty ``NUMBA_CACHE_DIR``: ``warmup_fresh_cache``, the time of ``eulerpoisson
-  warmup`` filling it (every kernel compiled; measured once), then in new processes the first
-  ``simulate`` of the small problem (``cli_first_simulate_after_warmup``) and of a large one that
-  runs the compiled kernel, 2*10^5 samples (``cli_first_compiled_simulate_after_warmup``: numba
-  imported and the kernel loaded from the cache).
+  warmup`` filling it (every kernel compiled, every usable core; measured once; the row records the
+  cores), then in new processes the first ``simulate`` of the small problem
+  (``cli_first_simulate_after_warmup``) and, for each method M of exact, taylor, symplectic and rk,
+  the first ``simulate`` of 10^5 samples, ``eulerpoisson simulate --inertia 1,2,3 --omega 1,0.1,0.5
+  --t-end 1000 --samples 100000 --method M --out y.nc`` (``cli_first_simulate_1e5_M``: numba imported
+  and the method's kernels loaded from the cache; every run is a new process, so each is the first use
+  of those kernels after the warm-up; rk is scipy's ``solve_ivp`` stepper, slow even warm: reported,
+  not judged).
 
 The subprocesses see the package as installed: ``.pyc`` files written and used (the default of
-Python; ``pip install`` compiles them), except in the ``_nopyc`` row. ``EULERPOISSON_WORKERS=1``.
-The goals: warm ``simulate`` <= 0.5 s; the first ``simulate`` after the warm-up <= 3 s.
-``--quick`` measures one run of each small command, skips the warm-up and the compiled row.
+Python; ``pip install`` compiles them), except in the ``_nopyc`` row. ``EULERPOISSON_WORKERS=1`` and
+the default ``EULERPOISSON_NUMPY_BELOW`` (run.py's 0 removed). The goals: warm ``simulate`` <= 0.5 s;
+``eulerpoisson warmup`` <= 10 s on 2 cores (issue 25 #5); the first ``simulate`` of 10^5 samples after
+the warm-up <= 0.5 s with exact, taylor and symplectic (issue 25 #5).
+``--quick`` measures one run of each command, skips the warm-up, and runs the first-simulate rows
+of each method with 1000 samples to t = 10 and numba's default cache (whatever it holds; not a fresh
+warm-up; the rows keep their names).
 
     .venv/bin/python benchmarks/run.py --only cold_start [--quick]
 """
@@ -51,21 +59,30 @@ SMALL = [
     "--overwrite",
     "--quiet",
 ]
-LARGE = [
-    "simulate",
-    "--inertia",
-    "1,2,3",
-    "--omega",
-    "1,0.1,0.5",
-    "--t-end",
-    "1000",
-    "--samples",
-    "200000",
-    "--out",
-    "y.nc",
-    "--overwrite",
-    "--quiet",
-]
+#: the methods of the first-simulate rows; rk (scipy's solve_ivp stepper) is reported, not judged
+METHODS = ("exact", "taylor", "symplectic", "rk")
+
+
+def first_simulate(method: str, quick: bool = False) -> list[str]:
+    """The command line (after ``eulerpoisson``) of the first-simulate row of ``method``: 10^5 samples to t = 1000
+    (``quick``: 1000 samples to t = 10, which costs the new process and numba's start but little else)."""
+    return [
+        "simulate",
+        "--inertia",
+        "1,2,3",
+        "--omega",
+        "1,0.1,0.5",
+        "--t-end",
+        "10" if quick else "1000",
+        "--samples",
+        "1000" if quick else "100000",
+        "--method",
+        method,
+        "--out",
+        "y.nc",
+        "--overwrite",
+        "--quiet",
+    ]
 
 
 def _env(**extra):
@@ -92,11 +109,14 @@ def _best(argv, cwd, env, repeats) -> tuple[float, int]:
 
 def run(quick: bool = False, log=print) -> dict:
     repeats = 1 if quick else 7
+    first_repeats = 1 if quick else 3
     out = {
         "config": {
             "small": " ".join(["eulerpoisson", *SMALL]),
-            "large": " ".join(["eulerpoisson", *LARGE]),
+            "first_simulate": " ".join(["eulerpoisson", *first_simulate("M", quick)]),
+            "methods": list(METHODS),
             "repeats": repeats,
+            "first_simulate_repeats": first_repeats,
         },
         "rows": [],
     }
@@ -137,20 +157,35 @@ def run(quick: bool = False, log=print) -> dict:
                 "eulerpoisson warmup into an empty NUMBA_CACHE_DIR (compiles every kernel)",
                 wall,
                 runs=1,
+                cores=_cores(),
             )
         what = "after eulerpoisson warmup" if not quick else "empty NUMBA_CACHE_DIR, no warm-up (quick)"
         wall, n = _best([EXE, *SMALL], tmp, fresh, repeats)
         add("cli_first_simulate_after_warmup", f"first simulate of 1001 samples in a new process, {what}", wall, runs=n)
-        if not quick:
-            wall, n = _best([EXE, *LARGE], tmp, fresh, max(1, repeats // 2))
+        # each method's first simulate of 10^5 samples: every run a new process, the first use of the method's
+        # kernels there (numba's cache is on disk); quick: numba's default cache, no fresh warm-up
+        what = "after the warm-up" if not quick else "numba's default cache (quick)"
+        samples = "1000" if quick else "1e5"
+        for method in METHODS:
+            how = " (scipy's stepper)" if method == "rk" else ""
+            wall, n = _best([EXE, *first_simulate(method, quick)], tmp, env if quick else fresh, first_repeats)
             add(
-                "cli_first_compiled_simulate_after_warmup",
-                f"first simulate of 2e5 samples (compiled kernel) in a new process, {what}",
+                f"cli_first_simulate_1e5_{method}",
+                f"first simulate, {samples} samples, --method {method}{how}, new process, {what}",
                 wall,
                 runs=n,
+                method=method,
+                cache="default" if quick else "fresh, after eulerpoisson warmup",
             )
         shutil.rmtree(cache, ignore_errors=True)
     return out
+
+
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - non-Linux
+        return os.cpu_count() or 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -13,9 +13,11 @@ which is fixed in space for the free body.
   has a play/pause button, a time slider, and drag-to-rotate for the view.
 * ``.gif`` — rendered by matplotlib and streamed to the file frame by frame
   (:class:`GifStreamWriter`, with Pillow, a dependency of matplotlib): memory
-  is bounded by two frames whatever their number.
-* ``.mp4`` — rendered with matplotlib's ``FFMpegWriter``; needs the
-  ``ffmpeg`` program.
+  is bounded by two frames whatever their number. The fixed orthographic view
+  of matplotlib's 3-D axes is applied as an affine map and the frames are
+  blitted on a 2-D axes: only what moves is drawn again.
+* ``.mp4`` — the same frames, piped to the ``ffmpeg`` program (H.264), as
+  matplotlib's ``FFMpegWriter`` does; needs ``ffmpeg``.
 
 The face colours are those of :data:`eulerpoisson.viz.plots.AXIS_COLORS`: the
 two faces normal to principal axis :math:`i` have the colour of axis
@@ -699,10 +701,12 @@ class GifStreamWriter:
     rectangle where it differs from the previous frame; a frame identical to
     the previous one lengthens the previous one's display time instead. The
     file is a GIF89a that loops forever, with a local colour table per frame.
-    Only the previous frame (and the one waiting to be written) is kept.
+    Only the previous frame (as one 32-bit word per pixel, to compare the
+    next one quickly) and the one waiting to be written are kept.
 
     The interface is that of a matplotlib movie writer: ``with
-    writer.saving(fig, path, dpi): ... writer.grab_frame()``.
+    writer.saving(fig, path, dpi): ... writer.grab_frame()``; a frame already
+    drawn (a canvas buffer, RGB or RGBA) is given to :meth:`add_frame`.
     """
 
     def __init__(self, fps):
@@ -725,7 +729,7 @@ class GifStreamWriter:
             FigureCanvasAgg(fig)
         fig.set_dpi(dpi)
         self._fh = open(outfile, "wb")
-        self._prev = None  # the previous frame (RGB array)
+        self._prev: np.ndarray | None = None  # the previous frame, one uint32 per pixel (see _key)
         # (P image, offset, duration in ms): written when the next frame differs
         self._pending: tuple[Any, tuple[int, int], float] | None = None
         self._size: tuple[int, int] | None = None
@@ -745,17 +749,36 @@ class GifStreamWriter:
 
     def grab_frame(self, **savefig_kwargs):
         self.fig.canvas.draw()
-        rgb = np.asarray(self.fig.canvas.buffer_rgba())[..., :3]
-        self.add_frame(rgb)
+        self.add_frame(np.asarray(self.fig.canvas.buffer_rgba()))
+
+    @staticmethod
+    def _key(a) -> np.ndarray:
+        """One uint32 per pixel holding its red, green and blue bytes (alpha left out), to compare frames."""
+        if a.shape[2] == 4:  # RGBA (a canvas buffer): the pixels as little-endian words, alpha masked
+            return np.ascontiguousarray(a).view("<u4")[..., 0] & np.uint32(0xFFFFFF)
+        r, g, b = (a[..., i].astype(np.uint32) for i in range(3))
+        return r | (g << np.uint32(8)) | (b << np.uint32(16))
 
     def add_frame(self, rgb) -> None:
-        """Add one frame, an (h, w, 3) uint8 array."""
+        """Add one frame, an (h, w, 3) RGB or (h, w, 4) RGBA uint8 array (alpha is ignored).
+
+        Raises
+        ------
+        InvalidInputError
+            ``rgb`` is not of shape (h, w, 3) or (h, w, 4), or its size differs
+            from the first frame's.
+        """
         from PIL import Image
 
-        rgb = np.ascontiguousarray(rgb, dtype=np.uint8)
-        h, w = rgb.shape[:2]
+        a = np.asarray(rgb)
+        if a.ndim != 3 or a.shape[2] not in (3, 4):
+            raise InvalidInputError(f"rgb must be an (h, w, 3) RGB or (h, w, 4) RGBA array, got shape {a.shape}")
+        if a.dtype != np.uint8:
+            a = a.astype(np.uint8)
+        h, w = a.shape[:2]
         duration = 1000.0 / self.fps
         assert self._fh is not None, "add_frame() after setup()"
+        key = self._key(a)
         if self._size is None:
             self._size = (w, h)
             self._fh.write(self._header(w, h))
@@ -763,20 +786,21 @@ class GifStreamWriter:
         else:
             if (w, h) != self._size:
                 raise InvalidInputError(f"GIF frames must all have the size {self._size}, got {(w, h)}")
-            diff = np.any(rgb != self._prev, axis=2)
+            diff = key != self._prev
             rows = np.flatnonzero(diff.any(axis=1))
             if rows.size == 0:  # the same picture: show the previous frame longer
                 assert self._pending is not None  # a frame was added before
                 im, off, d = self._pending
                 self._pending = (im, off, d + duration)
                 return
-            cols = np.flatnonzero(diff.any(axis=0))
+            cols = np.flatnonzero(diff[rows[0] : rows[-1] + 1].any(axis=0))
             box = (int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1)
         self._flush()
-        part = Image.fromarray(rgb[box[1] : box[3], box[0] : box[2]], "RGB")
+        # only the changed rectangle is copied, quantized and encoded
+        part = Image.fromarray(np.ascontiguousarray(a[box[1] : box[3], box[0] : box[2], :3]), "RGB")
         pim = part.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE)
         self._pending = (pim, box[:2], duration)
-        self._prev = rgb.copy()
+        self._prev = key  # a new array, not a view of the caller's buffer
         self.frames += 1
 
     def _flush(self) -> None:
@@ -801,14 +825,88 @@ class GifStreamWriter:
             self._fh = None
 
 
-def _writer(ext, fps):
-    from matplotlib import animation
+class _FfmpegStreamWriter:
+    """Pipe raw RGBA frames to the ``ffmpeg`` program (H.264, yuv420p), as matplotlib's ``FFMpegWriter`` does.
 
+    The frames come from a canvas buffer the caller has already drawn
+    (:meth:`add_frame`), so no figure is redrawn or saved per frame. The
+    program is the one matplotlib uses (``rcParams["animation.ffmpeg_path"]``).
+    """
+
+    def __init__(self, fps, binary):
+        self.fps = float(fps)
+        self.binary = str(binary)
+        self._proc: Any = None
+        self._err: Any = None
+        self._size: tuple[int, int] | None = None
+        self.frames = 0
+
+    def args(self, outfile, w, h) -> list[str]:
+        """The ffmpeg command line (that of matplotlib's writer) for ``w`` x ``h`` frames written to ``outfile``."""
+        frames_in = ["-f", "rawvideo", "-vcodec", "rawvideo", "-s", f"{w}x{h}", "-pix_fmt", "rgba"]
+        video_out = ["-vcodec", "libx264", "-pix_fmt", "yuv420p", "-y", str(outfile)]
+        return [self.binary, *frames_in, "-framerate", str(self.fps), "-loglevel", "error", "-i", "pipe:", *video_out]
+
+    @contextlib.contextmanager
+    def saving(self, fig, outfile, dpi):
+        self.setup(fig, outfile, dpi)
+        ok = False
+        try:
+            yield self
+            ok = True
+        finally:
+            self.finish(check=ok)
+
+    def setup(self, fig, outfile, dpi):
+        import subprocess
+        import tempfile
+
+        fig.set_dpi(dpi)
+        w, h = (int(round(v)) for v in fig.get_size_inches() * dpi)
+        self._size = (w, h)
+        self._err = tempfile.TemporaryFile()  # a file, not a pipe: ffmpeg never blocks on a full stderr pipe
+        self._proc = subprocess.Popen(
+            self.args(outfile, w, h), stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self._err
+        )
+        self.frames = 0
+
+    def add_frame(self, rgba) -> None:
+        """Add one frame, an (h, w, 4) uint8 RGBA array."""
+        a = np.ascontiguousarray(rgba, dtype=np.uint8)
+        assert self._proc is not None and self._size is not None, "add_frame() after setup()"
+        want = (self._size[1], self._size[0], 4)
+        if a.shape != want:
+            raise InvalidInputError(f"rgba must be an RGBA frame of shape (h, w, 4) = {want}, got shape {a.shape}")
+        try:
+            self._proc.stdin.write(a.data)
+        except BrokenPipeError:  # ffmpeg stopped: finish() reports why
+            self.finish(check=True)
+            raise
+        self.frames += 1
+
+    def finish(self, check=True):
+        import subprocess
+
+        if self._proc is None:
+            return
+        proc, self._proc = self._proc, None
+        with contextlib.suppress(BrokenPipeError):
+            proc.stdin.close()
+        rc = proc.wait()
+        self._err.seek(0)
+        err = self._err.read().decode("utf-8", "replace")
+        self._err.close()
+        if check and rc:
+            raise subprocess.CalledProcessError(rc, proc.args, None, err)
+
+
+def _writer(ext, fps):
     if ext == "gif":
         return GifStreamWriter(fps=fps)
-    if not animation.FFMpegWriter.isAvailable():
-        import matplotlib
+    import matplotlib
+    from matplotlib import animation
 
+    if not animation.FFMpegWriter.isAvailable():
         path = matplotlib.rcParams["animation.ffmpeg_path"]
         found = shutil.which(path)
         raise MissingDependencyError(
@@ -816,15 +914,67 @@ def _writer(ext, fps):
             f"{'' if found is None else ' at ' + found}); install ffmpeg (e.g. 'apt-get install ffmpeg' or "
             "'conda install ffmpeg') or write .html or .gif instead"
         )
-    return animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
+    return _FfmpegStreamWriter(fps, animation.FFMpegWriter.bin_path())
+
+
+def _ortho_projection(fig, rect, lim, view):
+    """Where matplotlib's orthographic 3-D axes in ``rect`` puts space points: a fixed affine map.
+
+    The axes has the cube ``[-lim, lim]^3`` with equal box aspect (zoom 1.35)
+    seen from ``view`` = (azimuth, elevation). Returns ``(position, xlim, ylim,
+    M)``: the axes' active position (a square in pixels), the limits of its 2-D
+    data coordinates, and its projection matrix ``M`` (4, 4), whose last row is
+    (0, 0, 0, w): see :func:`_project`. The 3-D axes is removed afterwards.
+    """
+    ax3 = fig.add_axes(rect, projection="3d")
+    try:
+        ax3.set_proj_type("ortho")
+        ax3.set_xlim(-lim, lim)
+        ax3.set_ylim(-lim, lim)
+        ax3.set_zlim(-lim, lim)
+        try:
+            ax3.set_box_aspect((1, 1, 1), zoom=1.35)
+        except TypeError:  # pragma: no cover - matplotlib < 3.7
+            ax3.set_box_aspect((1, 1, 1))
+        ax3.view_init(elev=view[1], azim=view[0])
+        ax3.apply_aspect()
+        M = np.asarray(ax3.get_proj(), float)
+        position = ax3.get_position(original=False).frozen()
+        xlim, ylim = tuple(ax3.viewLim.intervalx), tuple(ax3.viewLim.intervaly)
+    finally:
+        ax3.remove()
+    assert np.allclose(M[3, :3], 0.0, atol=1e-12 * abs(M[3, 3])), "an orthographic projection is affine"
+    return position, xlim, ylim, M
+
+
+def _project(M, X) -> np.ndarray:
+    """(x2, y2, depth) of the space points ``X`` (..., 3), computed as matplotlib's 3-D axes does; depth grows away."""
+    X = np.asarray(X, float)
+    vec = np.vstack([X.reshape(-1, 3).T, np.ones(X[..., 0].size)])
+    product = np.dot(M, vec)
+    return (product[:3] / product[3]).T.reshape(X.shape)
 
 
 def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
+    """Render the frames of a GIF/MP4 and stream them to the writer.
+
+    The view is fixed and orthographic, so matplotlib's 3-D projection is a
+    fixed affine map (:func:`_ortho_projection`): the box is drawn on a plain
+    2-D axes as polygons in painter's order (far faces first), the space axes
+    and m as polylines whose pieces hidden by the box are gaps, exactly where
+    the 3-D axes drew them. What never changes (white, axis letters, title) is
+    drawn once and blitted; each frame draws the faces, the lines, the tip, the
+    'm' label and the time text, and hands the canvas buffer to the writer.
+    The tip and the 'm' label, when they lie outside the region the box can
+    cover, look the same in every frame: their pixels are copied from the
+    first frame instead of drawn again.
+    """
     mpl = import_matplotlib()
     writer = _writer(ext, fps)  # fail early when ffmpeg is missing
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import PolyCollection
     from matplotlib.figure import Figure
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from matplotlib.transforms import Bbox
 
     from ..attitude.core import matrix_from_unit_quaternion
 
@@ -839,6 +989,7 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
     light /= np.linalg.norm(light)
     base = np.array([_face_rgb(a, s) for _, _, a, s in faces], float) / 255.0
     normals = np.array([nrm for _, nrm, _, _ in faces])
+    fidx = np.array([idx for idx, *_ in faces])  # (6, 4) vertex indices
     view = _view(mdir)
     cam = _camera(view)
     towards_viewer = cam[2]
@@ -849,57 +1000,81 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
     lines = [(-np.eye(3)[i] * lim, np.eye(3)[i] * lim, "#c3c7cd", 0.8) for i in range(3)]
     if mdir is not None:
         lines.append((np.zeros(3), arrow * mdir, "#111111", 2.2))
+    # the midpoints of all pieces (and the tip last): one occlusion test per frame
+    probe = np.concatenate([a + mid[:, None] * (b - a) for a, b, _, _ in lines] + [np.zeros((0, 3))])
+    if mdir is not None:
+        probe = np.concatenate([probe, (arrow * mdir)[None]])
     with mpl.rc_context({"font.size": 10}):
         fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi, layout="none")  # type: ignore[arg-type]  # "none" is documented
-        FigureCanvasAgg(fig)
+        canvas = FigureCanvasAgg(fig)
         fig.patch.set_facecolor("white")
-        ax = fig.add_axes([0.0, 0.0, 1.0, 0.9], projection="3d")  # type: ignore[call-overload]  # a list is a rect
+        position, xlim, ylim, M = _ortho_projection(fig, [0.0, 0.0, 1.0, 0.9], lim, view)
+        ax = fig.add_axes(position)
         ax.set_axis_off()
-        ax.set_proj_type("ortho")
-        ax.computed_zorder = False
-        ax.set_xlim(-lim, lim)
-        ax.set_ylim(-lim, lim)
-        ax.set_zlim(-lim, lim)
-        try:
-            ax.set_box_aspect((1, 1, 1), zoom=1.35)
-        except TypeError:  # pragma: no cover - matplotlib < 3.7
-            ax.set_box_aspect((1, 1, 1))
-        ax.view_init(elev=view[1], azim=view[0])
+        ax.set_xlim(*xlim)
+        ax.set_ylim(*ylim)
         for i in range(3):
-            ax.text(*(1.05 * np.eye(3)[i] * lim), "xyz"[i], color="#888888", ha="center", va="center", zorder=0)
-        coll = Poly3DCollection([verts[idx] for idx, *_ in faces], zorder=1, linewidths=0.6)
-        ax.add_collection3d(coll)
-        artists = []
-        for _a, _b, color, lw in lines:
-            (ln,) = ax.plot([], [], [], color=color, lw=lw, zorder=2, solid_capstyle="butt")
+            x2, y2, _ = _project(M, 1.05 * np.eye(3)[i] * lim)
+            ax.text(x2, y2, "xyz"[i], color="#888888", ha="center", va="center", zorder=0)
+        coll = PolyCollection([], zorder=1, linewidths=0.6, animated=True)
+        ax.add_collection(coll, autolim=False)
+        artists, line_xy = [], []
+        for a, b, color, lw in lines:
+            (ln,) = ax.plot([], [], color=color, lw=lw, zorder=2, solid_capstyle="butt", animated=True)
             artists.append(ln)
-        tip = None
+            line_xy.append(_project(M, a + pieces[:, None] * (b - a))[:, :2])
+        on_top = []  # drawn after the faces and lines
         if mdir is not None:
-            tip = ax.scatter(
-                [arrow * mdir[0]],
-                [arrow * mdir[1]],
-                [arrow * mdir[2]],
-                color="#111111",
-                marker="o",
-                s=16,
-                zorder=3,
-                depthshade=False,
+            tx, ty, _ = _project(M, arrow * mdir)
+            tip = ax.scatter([tx], [ty], color="#111111", marker="o", s=16, zorder=3, animated=True)
+            lx, ly, _ = _project(M, 1.04 * arrow * mdir + 0.1 * lim * cam[1])
+            mlabel = ax.text(
+                lx, ly, "m", color="#111111", zorder=3, ha="center", va="center", fontsize=11, animated=True
             )
-            ax.text(
-                *(1.04 * arrow * mdir + 0.1 * lim * cam[1]),
-                "m",
-                color="#111111",
-                zorder=3,
-                ha="center",
-                va="center",
-                fontsize=11,
-            )
+            on_top = [tip, mlabel]
         # names are text: no mathtext ($...$ in a body name is drawn as typed)
-        fig.text(0.5, 0.965, plain_text(one.label + " — " + one.method), ha="center", va="center", fontsize=10)
-        ttext = fig.text(0.5, 0.925, "", ha="center", va="center", fontsize=9, color="#444444")
+        title = fig.text(0.5, 0.965, plain_text(one.label + " — " + one.method), ha="center", va="center", fontsize=10)
+        ttext = fig.text(0.5, 0.925, "", ha="center", va="center", fontsize=9, color="#444444", animated=True)
+        last = [ttext]  # drawn after everything else
         Rf = matrix_from_unit_quaternion(qf)
         with atomic_path(out, suffix="." + ext) as tmp:
             with writer.saving(fig, tmp, dpi):
+                renderer = canvas.get_renderer()
+                # the title is drawn after the axes: where it may overlap what moves (clipped to the axes) or
+                # the 'm' label, it is drawn again in every frame
+                tb = title.get_window_extent(renderer).padded(2)
+                if tb.overlaps(ax.bbox) or (on_top and tb.overlaps(mlabel.get_window_extent(renderer))):
+                    title.set_animated(True)
+                    last.insert(0, title)
+                canvas.draw()  # the background: what does not move (animated artists are left out)
+                background = canvas.copy_from_bbox(fig.bbox)
+                renderer = canvas.get_renderer()
+                # the pixels the box can reach in some frame, with its gaps in the lines: the disc of the sphere
+                # of radius R0 around the centre, widened by a line width, a piece's length and antialiasing
+                J = ax.transData.get_affine().get_matrix()[:2, :2] @ (M[:2, :3] / M[3, 3])  # space -> pixels
+                centre = ax.transData.transform(_project(M, np.zeros(3))[:2])
+                piece = max(np.linalg.norm(J @ (b - a)) for a, b, _, _ in lines) / (len(pieces) - 1)
+                reach = R0 * np.linalg.norm(J, 2) + 3.0 + 2.2 * dpi / 72.0 + piece
+                ttext.set_text(plain_text(f"t = {tf[0]:.2f} {one.time_unit}"))
+                band = ttext.get_window_extent(renderer)  # the time text's width changes: its whole row
+                busy = [Bbox.from_extents(0, band.y0 - 3, w, band.y1 + 3)]
+                busy += [a.get_window_extent(renderer).padded(3) for a in last[:-1]]
+                frozen = {}  # artist -> its bbox, for those whose pixels are those of the first frame
+                for artist in on_top:
+                    if artist is tip:  # a marker of area s (points^2) with its edge, around its centre
+                        mx, my = ax.transData.transform((tx, ty))
+                        edge = float(np.atleast_1d(tip.get_linewidth())[0])
+                        r = (0.5 * np.sqrt(tip.get_sizes()[0]) + 0.5 * edge) * dpi / 72.0
+                        ext = Bbox.from_extents(mx - r, my - r, mx + r, my + r)
+                    else:
+                        ext = artist.get_window_extent(renderer)
+                    bb = Bbox.intersection(ext.padded(3), fig.bbox)
+                    if bb is None:
+                        continue
+                    near = np.clip(centre, bb.min, bb.max)  # the point of bb nearest to the centre
+                    if np.hypot(*(near - centre)) > reach and not any(bb.overlaps(b) for b in busy):
+                        frozen[artist] = bb
+                snapshots = []
                 for k in range(len(tf)):
                     Rk = Rf[k]
                     V = verts @ Rk.T
@@ -907,26 +1082,35 @@ def _render_video(one, sides, verts, faces, mdir, tf, qf, out, ext, fps, px):
                     lam = np.clip((N @ cam.T) @ light, 0.0, None)
                     shade = (0.5 + 0.5 * lam)[:, None]
                     fc = np.clip(base * shade, 0, 1)
-                    coll.set_verts([V[idx] for idx, *_ in faces])
-                    coll.set_facecolor(fc)
-                    coll.set_edgecolor(fc * 0.55)
-                    for (a, b, _, _), ln in zip(lines, artists):
-                        P = a + pieces[:, None] * (b - a)
-                        hid = hidden_by_box(
-                            a + mid[:, None] * (b - a), Rk, half, one.axes, towards_viewer, orthographic=True
-                        )
+                    pv = _project(M, V)  # (8, 3): x2, y2, depth (growing away from the viewer)
+                    order = np.argsort(pv[fidx, 2].mean(axis=1))[::-1]  # painter's order: far faces first
+                    coll.set_verts(pv[fidx[order], :2])  # type: ignore[arg-type]  # a (6, 4, 2) array, as mplot3d
+                    coll.set_facecolor(fc[order])
+                    coll.set_edgecolor(fc[order] * 0.55)
+                    hid = hidden_by_box(probe, Rk, half, one.axes, towards_viewer, orthographic=True)
+                    for i, (xy, ln) in enumerate(zip(line_xy, artists)):
+                        h_i = hid[i * len(mid) : (i + 1) * len(mid)]
                         # a point is kept when one of its two pieces is visible
-                        keep = np.zeros(len(P), bool)
-                        keep[:-1] |= ~hid
-                        keep[1:] |= ~hid
-                        Pn = np.where(keep[:, None], P, np.nan)
-                        ln.set_data_3d(Pn[:, 0], Pn[:, 1], Pn[:, 2])
-                    if tip is not None:
-                        tip.set_visible(
-                            not hidden_by_box(
-                                (arrow * mdir)[None], Rk, half, one.axes, towards_viewer, orthographic=True
-                            )[0]
-                        )
+                        keep = np.zeros(len(xy), bool)
+                        keep[:-1] |= ~h_i
+                        keep[1:] |= ~h_i
+                        xyn = np.where(keep[:, None], xy, np.nan)
+                        ln.set_data(xyn[:, 0], xyn[:, 1])
+                    if on_top:
+                        tip.set_visible(not hid[-1])
                     ttext.set_text(plain_text(f"t = {tf[k]:.2f} {one.time_unit}"))
-                    writer.grab_frame()
+                    canvas.restore_region(background)
+                    coll.draw(renderer)
+                    for ln in artists:
+                        ln.draw(renderer)
+                    for artist in on_top:
+                        if k == 0 or artist not in frozen:
+                            artist.draw(renderer)
+                    if k == 0:
+                        snapshots = [canvas.copy_from_bbox(bb) for bb in frozen.values()]
+                    for region in snapshots:
+                        canvas.restore_region(region)
+                    for artist in last:
+                        artist.draw(renderer)
+                    writer.add_frame(np.asarray(canvas.buffer_rgba()))
     return out

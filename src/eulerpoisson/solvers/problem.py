@@ -23,7 +23,7 @@ if TYPE_CHECKING:
     from ..attitude.core import AttitudeLike
     from ..model.torques import TorqueLike
 
-__all__ = ["Problem", "make_problem", "initial_quaternion", "compose_initial"]
+__all__ = ["Problem", "make_problem", "initial_quaternion", "compose_initial", "left_composed"]
 
 
 @dataclass(frozen=True)
@@ -228,7 +228,23 @@ def compose_initial(problem: Problem, q_rel: np.ndarray) -> np.ndarray:
     """
     if not problem.model.is_free:
         raise ValueError("compose_initial is a free-body shortcut (left invariance); the model has torques")
-    q0 = problem.q0
+    return left_composed(problem.q0, q_rel)
+
+
+def left_composed(q0: np.ndarray, q_rel: np.ndarray) -> np.ndarray:
+    r""":math:`q_0\otimes q_\mathrm{rel}(t)`: ``q0`` (*batch, 4), ``q_rel`` (*batch, T, 4); ``q_rel`` itself where
+    every ``q0`` is the identity (:func:`compose_initial` without its problem).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.solvers.problem import left_composed
+    >>> q_rel = np.array([[0.0, 1.0, 0.0, 0.0]])
+    >>> left_composed(np.array([1.0, 0.0, 0.0, 0.0]), q_rel) is q_rel
+    True
+    >>> print(left_composed(np.array([0.0, 0.0, 1.0, 0.0]), q_rel))
+    [[ 0.  0.  0. -1.]]
+    """
     if q0.ndim == 1:  # one body (plain floats: cheaper than four array reductions)
         w, x, y, z = q0.tolist()
         if w == 1.0 and x == 0.0 and y == 0.0 and z == 0.0:

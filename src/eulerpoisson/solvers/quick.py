@@ -16,10 +16,13 @@ and does only what it needs:
   with options of plain values (their checked configuration is kept in a
   small cache).
 
-It then calls what the engine calls (the method's :meth:`~.Method.for_batch`
-and :meth:`~.Method.run` through :func:`~.parallel.solve_batch`, the same
-:class:`~eulerpoisson.trajectory.Trajectory`), so the result is the one of
-the general path, bit for bit and field for field (tested). Anything else,
+It then calls the method's shortcut for one body (:meth:`~.Method.run_one`:
+the exact method and taylor have one, which skip the problem and its
+layers), or else what the engine calls (the method's
+:meth:`~.Method.for_batch` and :meth:`~.Method.run` through
+:func:`~.parallel.solve_batch`), and makes the same
+:class:`~eulerpoisson.trajectory.Trajectory`: the result is the one of the
+general path, bit for bit and field for field (tested). Anything else,
 including every input that is not valid, returns None: the general path
 then solves it or raises its error.
 """
@@ -27,6 +30,7 @@ then solves it or raises its error.
 from __future__ import annotations
 
 import math
+import os
 import time as _time
 from typing import TYPE_CHECKING, Any
 
@@ -38,7 +42,7 @@ from ..model.equations import Model
 from ..trajectory import Trajectory
 from ..util.jit import run_shape, whole_run
 from . import engine
-from .parallel import solve_batch
+from .parallel import ENV_WORKERS, resolve_workers, solve_batch
 from .problem import Problem, initial_quaternion
 from .registry import check_supported, get_method
 
@@ -205,11 +209,18 @@ def quick_solve(
         turns = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * max(abs(v) for v in times)
         if not (math.isfinite(turns) and turns <= engine.SEGMENT_TURNS):
             return None
-    problem = Problem(model=model, q0=q0, omega0=wa, t=tt)
+    if os.environ.get(ENV_WORKERS):  # (a bad setting is an error for one body too: the general path raises it)
+        try:
+            resolve_workers(None)
+        except (TypeError, ValueError):
+            return None
     n = len(times)
     with whole_run(*run_shape(0, n)):
-        planned = m.for_batch(problem)
-        res = solve_batch(planned, problem, None)
+        res = m.run_one(b, q0, wa, tt)  # the method's shortcut for one body, when it has one
+        if res is None:
+            problem = Problem(model=model, q0=q0, omega0=wa, t=tt)
+            m = m.for_batch(problem)
+            res = solve_batch(m, problem, None)
     tr = Trajectory(
         t=tt,
         quaternion=res.q,
@@ -217,7 +228,7 @@ def quick_solve(
         body=b,
         torque=model.torques,
         method=name,
-        options=dict(planned.config),
+        options=dict(m.config),
         stats={"wall_time": 0.0, **res.stats},
         _prepared=res.prepared,
     )

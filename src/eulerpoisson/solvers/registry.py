@@ -11,13 +11,16 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field, fields
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
 from ..errors import InvalidInputError, UnsupportedModelError
 from ..model.equations import Model
 from .problem import Problem
+
+if TYPE_CHECKING:
+    from ..model.body import RigidBody
 
 __all__ = [
     "hybridmethod",
@@ -234,6 +237,19 @@ class Method:
 
     def run(self, problem: Problem) -> MethodResult:  # pragma: no cover - abstract
         raise NotImplementedError
+
+    def run_one(self, body: RigidBody, q0: np.ndarray, omega0: np.ndarray, t: np.ndarray) -> MethodResult | None:
+        """One free body, for the quick lane of :func:`~eulerpoisson.solve` (:mod:`.quick`): or None.
+
+        ``body`` has batch shape ``()``; ``q0`` (4,), ``omega0`` (3,) and ``t``
+        (T,) are checked float64 arrays (a unit quaternion, finite numbers,
+        the method's time range). A method may return here what
+        ``solve_batch(self.for_batch(problem), problem)`` returns for that
+        problem, bit for bit and stats included (``"threads": 1``), without
+        building the problem; None (the default) where it has no such
+        shortcut: the quick lane then takes that general route.
+        """
+        return None
 
     def for_batch(self, problem: Problem) -> Method:
         """This method with every choice that depends on the whole batch made on ``problem``.

@@ -41,7 +41,7 @@ from ...attitude.core import quaternion_from_rotation_matrix
 from ...errors import InvalidInputError
 from ...numerics.quaternion import qmul
 from ...util import jit
-from ..problem import Problem, compose_initial
+from ..problem import Problem, compose_initial, left_composed
 from ..registry import Method, MethodOptions, MethodResult, register_method
 
 __all__ = ["Exact"]
@@ -69,11 +69,15 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
         (``speed`` replaces :math:`|\boldsymbol\Omega_0|` when given: a
         heavy top's rate includes :math:`\sqrt{\mu g\ell/A}`).
     """
-    if problem.t.size == 0:
+    _check_phase(problem.t, problem.omega0, speed)
+
+
+def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
+    """:func:`_check_phase_range` on the times ``t`` (T,) and initial rates ``w`` (*batch, 3)."""
+    if t.size == 0:
         return
-    w = problem.omega0
-    few = w.ndim == 1 and problem.t.size <= 16  # one body at a few times: the maxima in plain floats
-    tmax = max(abs(x) for x in problem.t.tolist()) if few else float(np.abs(problem.t).max())
+    few = w.ndim == 1 and t.size <= 16  # one body at a few times: the maxima in plain floats
+    tmax = max(abs(x) for x in t.tolist()) if few else float(np.abs(t).max())
     if speed is None:
         # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
         wmax = (
@@ -175,17 +179,12 @@ class Exact(Method):
         Measured (benchmarks/README.md, cold start): the free body about 2 ms per call, 8 microseconds per
         body and 2 per (body, time); the Lagrange top about 5 ms, 20 and 2.5.
         """
-        # a part of a larger run (chunks of times or points): the size of the whole run decides
-        B, T = jit.run_shape(math.prod(problem.batch_shape), problem.t.shape[0])
-        if not problem.model.is_free:
-            return 5e-3 + 20e-6 * B + 2.5e-6 * B * T
-        return 2e-3 + 8e-6 * B + 2e-6 * B * T
+        return _numpy_seconds(math.prod(problem.batch_shape), problem.t.shape[0], problem.model.is_free)
 
     def python_estimate(self, problem: Problem) -> float:
         """Seconds of the scalar kernel run as plain Python (the free body): about 0.1 ms per body and 0.11 ms
         per (body, time) (the compiled kernel's numbers, no numba start; :func:`~eulerpoisson.util.jit.python_twins`)."""
-        B, T = jit.run_shape(math.prod(problem.batch_shape), problem.t.shape[0])
-        return 1.0e-4 * B + 1.1e-4 * B * T
+        return _python_seconds(math.prod(problem.batch_shape), problem.t.shape[0])
 
     def _free_path(self, problem: Problem) -> str:
         """The free body's path, from the size of the run alone: ``"compiled"``, ``"python"`` or ``"numpy"``.
@@ -196,12 +195,7 @@ class Exact(Method):
         """
         if self._path is not None:
             return self._path
-        numpy_seconds = self.numpy_estimate(problem)
-        if jit.use_compiled(numpy_seconds):
-            return "compiled"
-        if self.python_estimate(problem) < numpy_seconds:
-            return "compiled" if jit.USE_NUMBA and jit.numba_active() else "python"
-        return "numpy"
+        return _free_path_of(math.prod(problem.batch_shape), problem.t.shape[0])
 
     def _use_compiled(self, problem: Problem) -> bool:
         return self._compiled if self._compiled is not None else jit.use_compiled(self.numpy_estimate(problem))
@@ -216,6 +210,24 @@ class Exact(Method):
             planned._compiled = self._use_compiled(problem)
         planned._principal = _principal_frame(problem)
         return planned
+
+    def run_one(self, body, q0, omega0, t) -> MethodResult | None:
+        """One free body whose principal frame is the body frame (the quick lane, :meth:`Method.run_one`):
+        what :meth:`run` computes for it, without the problem."""
+        from .motion import exact_motion_unchecked as exact_motion
+
+        if not _all_identity(body.principal_axes):
+            return None
+        T = t.shape[0]
+        path = self._path if self._path is not None else _free_path_of(1, T)
+        _check_phase(t, omega0)
+        Ip = body.principal_moments
+        Mp, q_rel = exact_motion(Ip, Ip * omega0, t, compiled={"compiled": True, "numpy": False}.get(path, path))
+        return MethodResult(
+            q=left_composed(q0, q_rel),
+            omega=Mp / Ip[..., None, :],
+            stats={"evaluations": T, "compiled": path == "compiled" and jit.USE_NUMBA, "threads": 1},
+        )
 
     def run(self, problem: Problem) -> MethodResult:
         # (the problem is checked: float64, finite, moments > 0; the kernels need no second check)
@@ -295,6 +307,30 @@ class Exact(Method):
                 "compiled": bool(compiled and _numba_in_use()),
             },
         )
+
+
+def _numpy_seconds(n_bodies: int, n_times: int, free: bool) -> float:
+    """:meth:`Exact.numpy_estimate` for a problem of this size (the whole run's size decides, :func:`~eulerpoisson.util.jit.run_shape`)."""
+    B, T = jit.run_shape(n_bodies, n_times)
+    if not free:
+        return 5e-3 + 20e-6 * B + 2.5e-6 * B * T
+    return 2e-3 + 8e-6 * B + 2e-6 * B * T
+
+
+def _python_seconds(n_bodies: int, n_times: int) -> float:
+    """:meth:`Exact.python_estimate` for a problem of this size."""
+    B, T = jit.run_shape(n_bodies, n_times)
+    return 1.0e-4 * B + 1.1e-4 * B * T
+
+
+def _free_path_of(n_bodies: int, n_times: int) -> str:
+    """:meth:`Exact._free_path` for a free-body problem of this size."""
+    numpy_seconds = _numpy_seconds(n_bodies, n_times, True)
+    if jit.use_compiled(numpy_seconds):
+        return "compiled"
+    if _python_seconds(n_bodies, n_times) < numpy_seconds:
+        return "compiled" if jit.USE_NUMBA and jit.numba_active() else "python"
+    return "numpy"
 
 
 def _numba_in_use() -> bool:

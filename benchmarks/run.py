@@ -335,7 +335,8 @@ def _issue25_goals(wp, tp, tq, ft, exact, cold, suite) -> list[dict]:
     g = _goal(
         "[25.1c] taylor: one body to t = 100 at tol = eps no slower than heyoka's taylor_adaptive, "
         "at equal or better accuracy",
-        "t_taylor / t_heyoka <= 1 and error_taylor <= error_heyoka",
+        "t_taylor / t_heyoka <= 1 on the reference problem and error_taylor <= error_heyoka (the median over "
+        "40 random bodies when measured: one problem's error is one sample of the rounding)",
     )
     if wp:
         ta, hy = _curve_point(wp, "taylor", C.EPS), _curve_point(wp, "heyoka", C.EPS)
@@ -345,8 +346,17 @@ def _issue25_goals(wp, tp, tq, ft, exact, cold, suite) -> list[dict]:
                 f"t = {wp['problem']['t_end']:g}: taylor {ta['time_s'] * 1e3:.3g} ms "
                 f"({ta['error_rad']:.1e} rad), heyoka {hy['time_s'] * 1e3:.3g} ms ({hy['error_rad']:.1e} rad)"
             )
+            rb = wp.get("random_bodies")
+            if rb:
+                accurate = rb["taylor_median_rad"] <= rb["heyoka_median_rad"]
+                g["measured"] += (
+                    f"; {rb['bodies']} random bodies: median error taylor {rb['taylor_median_rad']:.1e} rad "
+                    f"({rb['taylor_steps']} steps), heyoka {rb['heyoka_median_rad']:.1e} rad ({rb['heyoka_steps']} steps)"
+                )
+            else:
+                accurate = ta["error_rad"] <= hy["error_rad"]
             g["ratio"] = ratio
-            g["status"] = _status(ratio <= 1.0 and ta["error_rad"] <= hy["error_rad"])
+            g["status"] = _status(ratio <= 1.0 and accurate)
         else:
             g["measured"] = NO_HEYOKA
     goals.append(g)

@@ -22,8 +22,13 @@ from pathlib import Path
 
 import pytest
 
+from _limits import HANG_GUARD_S
+
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
 
+
+#: the limit of the "timed out" case of the test-suite benchmark (its make test sleeps 20 s)
+_SLEEPS_PAST = 0.5
 
 #: issue 25's goals, by the prefix of their text, and how many goals each prefix has
 ISSUE25 = {
@@ -314,8 +319,9 @@ def test_test_suite_on_a_throwaway_repository(case, tmp_path, monkeypatch):
     for var in ("NUMBA_CACHE_DIR", "EULERPOISSON_WORKERS", "OMP_NUM_THREADS"):
         monkeypatch.setenv(var, "1")
     with _benchmarks():
-        timeout = 0.5 if case == "timed out" else 60.0
-        out = importlib.import_module("bench_test_suite").run(log=lambda line: None, root=repo, timeout=timeout)
+        # the "timed out" case: a deliberately short limit (the others: the hang guard, as every wait of the tests)
+        limit = _SLEEPS_PAST if case == "timed out" else HANG_GUARD_S
+        out = importlib.import_module("bench_test_suite").run(log=lambda line: None, root=repo, timeout=limit)
         goals = importlib.import_module("run").evaluate_goals(None, None, None, suite=out)
     rows = {r["name"]: r for r in out["rows"]}
     total = rows["make_test"]

@@ -76,6 +76,24 @@ def pytest_xdist_make_scheduler(config, log):
 
 
 @pytest.fixture
+def xla_optimized():
+    """XLA's optimizing passes on for one test (the module turns them off: JAX_DISABLE_MOST_OPTIMIZATIONS).
+
+    For the tests whose programs run longer than they compile: the docstring examples of eulerpoisson.jax
+    (measured on 2 cores: 210 s without the passes for the five modules, 66 s with them) and the gradient fit
+    of examples/jax_fit.py (67 s against 41 s: 400 evaluations of its chi2). A program compiled before in
+    the same process keeps the code it was compiled with (the values are the same either way).
+    """
+    jax = pytest.importorskip("jax", reason="jax is not installed: pip install 'eulerpoisson[jax]'")
+    previous = jax.config.values["jax_disable_most_optimizations"]
+    jax.config.update("jax_disable_most_optimizations", False)
+    try:
+        yield
+    finally:
+        jax.config.update("jax_disable_most_optimizations", previous)
+
+
+@pytest.fixture
 def rng():
     return np.random.default_rng(20261121)
 

@@ -14,7 +14,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.slow
-def test_the_jax_gradient_fit_finds_the_optimum_of_ep_fit(tmp_path, monkeypatch):
+def test_the_jax_gradient_fit_finds_the_optimum_of_ep_fit(tmp_path, monkeypatch, xla_optimized):
     monkeypatch.syspath_prepend(str(ROOT / "examples"))
     sys.modules.pop("jax_fit", None)
     import jax_fit

@@ -88,6 +88,10 @@ BENCHMARKS = ("work_precision", "long_run", "throughput", "torque", "fit", "exac
 README = HERE / "README.md"
 README_START = "<!-- results:start -->"
 README_END = "<!-- results:end -->"
+#: the project's README: its Speed table is regenerated from the goals of a full run (between these markers)
+MAIN_README = HERE.parent / "README.md"
+SPEED_START = "<!-- speed:start -->"
+SPEED_END = "<!-- speed:end -->"
 
 
 def _module(name):
@@ -697,6 +701,34 @@ def summary_markdown(
     return "\n".join(L)
 
 
+def speed_table(goals: list[dict], machine: dict) -> str:
+    """The Speed table of the project's README: every goal of this run with its measurement and status."""
+    lines = [
+        f"Measured {C.now_iso()[:10]} by `make bench` on {machine['cpu']}, {machine['usable_cpus']} cores "
+        f"(peers: {', '.join(machine.get('peers', []))}; goals prefixed [25.N] are issue 25's targets):",
+        "",
+        "| goal (ratio against a peer in the same run) | measured | status |",
+        "|---|---|---|",
+    ]
+    for g in goals:
+        measured = str(g["measured"]).replace("|", "/")
+        lines.append(f"| {g['goal']} | {measured} | {g['status'].lower()} |")
+    return "\n".join(lines)
+
+
+def _update_speed_table(goals: list[dict], machine: dict) -> bool:
+    """Write :func:`speed_table` between the markers of the README's Speed section; False without them."""
+    if not MAIN_README.exists():
+        return False
+    text = MAIN_README.read_text(encoding="utf-8")
+    if SPEED_START not in text or SPEED_END not in text:
+        return False
+    head, rest = text.split(SPEED_START, 1)
+    _, tail = rest.split(SPEED_END, 1)
+    MAIN_README.write_text(f"{head}{SPEED_START}\n{speed_table(goals, machine)}\n{SPEED_END}{tail}", encoding="utf-8")
+    return True
+
+
 def _update_readme(summary: str) -> bool:
     if not README.exists():
         return False
@@ -804,6 +836,8 @@ def main(argv=None) -> int:
     ):
         if _update_readme(summary):
             print(f"  -> {README} (results block)")
+        if _update_speed_table(goals, machine):
+            print(f"  -> {MAIN_README} (Speed table)")
     return 0
 
 

@@ -354,3 +354,25 @@ def test_heyoka_peer_matches_exact():
     tr = solve(list(C.INERTIA), [10.0], omega0=list(C.OMEGA0))
     assert C.attitude_error(q, tr.quaternion[0]) < 1e-13
     assert max(abs(a - b) for a, b in zip(om, tr.omega[0])) < 1e-13
+
+
+def test_the_readme_speed_table_is_made_from_the_goals(quick_run, tmp_path, monkeypatch):
+    goals = json.loads((quick_run / "goals.json").read_text())
+    with _benchmarks():
+        run = importlib.import_module("run")
+        table = run.speed_table(goals["goals"], goals["machine"])
+        rows = [line for line in table.splitlines() if line.startswith("| ") and "---" not in line][1:]
+        assert len(rows) == len(goals["goals"])
+        for g, row in zip(goals["goals"], rows):
+            assert row.startswith(f"| {g['goal']} |") and row.endswith(f"| {g['status'].lower()} |")
+        # the README's table is replaced between its markers, the rest of the file kept
+        readme = tmp_path / "README.md"
+        readme.write_text(f"intro\n{run.SPEED_START}\nold table\n{run.SPEED_END}\nrest\n", encoding="utf-8")
+        monkeypatch.setattr(run, "MAIN_README", readme)
+        assert run._update_speed_table(goals["goals"], goals["machine"])
+        text = readme.read_text(encoding="utf-8")
+        assert text.startswith("intro\n") and text.endswith(f"{run.SPEED_END}\nrest\n") and "old table" not in text
+        assert table in text
+    # the project's README has the markers
+    text = (BENCH.parent / "README.md").read_text(encoding="utf-8")
+    assert text.count("<!-- speed:start -->") == 1 and text.count("<!-- speed:end -->") == 1

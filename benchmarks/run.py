@@ -308,6 +308,16 @@ def evaluate_goals(wp, lr, tp, tq=None, ft=None, exact=None, cold=None, suite=No
     return goals
 
 
+def _rate_against_heyoka(g: dict, tp, ours: str, peer: str, detail) -> None:
+    """Fill goal ``g``: the rate of row ``ours`` of the throughput benchmark against heyoka's row ``peer`` (>= 1)."""
+    r, h = (_row(tp["rows"], k) for k in (ours, peer)) if tp else (None, None)
+    if r and h:
+        g["measured"] = f"{r['value']:.3g} vs {h['value']:.3g} body-s/s" + detail(r, h)
+        g["ratio"], g["status"] = r["value"] / h["value"], _status(r["value"] >= h["value"])
+    elif tp:
+        g["measured"] = NO_HEYOKA
+
+
 def _issue25_goals(wp, tp, tq, ft, exact, cold, suite) -> list[dict]:
     """The seven targets of issue 25, in its order, each with its peer where it has one."""
     goals = []
@@ -370,26 +380,18 @@ def _issue25_goals(wp, tp, tq, ft, exact, cold, suite) -> list[dict]:
         "[25.2] taylor: batch mode per core at least heyoka's batch mode (tol = eps, one thread each)",
         "body-s/s(taylor batch) / body-s/s(heyoka batch) >= 1",
     )
-    r, h = (_row(tp["rows"], k) for k in ("taylor_batch", "heyoka_batch")) if tp else (None, None)
-    if r and h:
-        g["measured"] = f"{r['value']:.3g} vs {h['value']:.3g} body-s/s (heyoka SIMD width {h.get('simd_width', '?')})"
-        g["ratio"], g["status"] = r["value"] / h["value"], _status(r["value"] >= h["value"])
-    elif tp:
-        g["measured"] = NO_HEYOKA
+    _rate_against_heyoka(
+        g, tp, "taylor_batch", "heyoka_batch", lambda r, h: f" (heyoka SIMD width {h.get('simd_width', '?')})"
+    )
     goals.append(g)
     g = _goal(
         "[25.2] taylor batch on all cores at least heyoka with one batch integrator per thread "
         "(written the fast way, as many threads)",
         "body-s/s(taylor, workers = cores) / body-s/s(heyoka, a batch integrator per thread) >= 1",
     )
-    r, h = (
-        (_row(tp["rows"], k) for k in ("threads_taylor_vs_heyoka_taylor", "heyoka_per_thread")) if tp else (None, None)
+    _rate_against_heyoka(
+        g, tp, "threads_taylor_vs_heyoka_taylor", "heyoka_per_thread", lambda r, h: f" on {r['workers']} threads"
     )
-    if r and h:
-        g["measured"] = f"{r['value']:.3g} vs {h['value']:.3g} body-s/s on {r['workers']} threads"
-        g["ratio"], g["status"] = r["value"] / h["value"], _status(r["value"] >= h["value"])
-    elif tp:
-        g["measured"] = NO_HEYOKA
     goals.append(g)
 
     # 3. the closed form (bench_exact.py) --------------------------------------------------------------------

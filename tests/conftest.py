@@ -81,16 +81,21 @@ def xla_optimized():
 
     For the tests whose programs run longer than they compile: the docstring examples of eulerpoisson.jax
     (measured on 2 cores: 210 s without the passes for the five modules, 66 s with them) and the gradient fit
-    of examples/jax_fit.py (67 s against 41 s: 400 evaluations of its chi2). A program compiled before in
-    the same process keeps the code it was compiled with (the values are the same either way).
+    of examples/jax_fit.py (67 s against 41 s: 400 evaluations of its chi2). The two settings can round
+    differently (fused or reordered operations), and JAX's in-memory cache of compiled programs does not
+    tell them apart: it is emptied before and after, so that no program compiled one way serves a test that
+    runs the other way (later tests of the worker compile again, or read the persistent cache, whose key
+    has the setting).
     """
     jax = pytest.importorskip("jax", reason="jax is not installed: pip install 'eulerpoisson[jax]'")
     previous = jax.config.values["jax_disable_most_optimizations"]
+    jax.clear_caches()
     jax.config.update("jax_disable_most_optimizations", False)
     try:
         yield
     finally:
         jax.config.update("jax_disable_most_optimizations", previous)
+        jax.clear_caches()
 
 
 @pytest.fixture

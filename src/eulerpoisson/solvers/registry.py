@@ -27,6 +27,7 @@ __all__ = [
     "MethodOptions",
     "Method",
     "MethodResult",
+    "overrides",
     "register_method",
     "unregister_method",
     "available_methods",
@@ -157,6 +158,25 @@ def _check_names(options_cls, given) -> None:
     if unknown:
         allowed = ", ".join(sorted(options_cls.names())) or "none"
         raise TypeError(f"method {options_cls.method!r} got unknown option(s) {', '.join(unknown)}; allowed: {allowed}")
+
+
+def overrides(method: object, base: type, names: tuple[str, ...]) -> bool:
+    """Whether the class of ``method`` redefines any of the attributes ``names`` of ``base`` (a plug-in subclass).
+
+    A shortcut that stands for some of a method's steps (:meth:`Method.run_one`) holds only while the class
+    runs those steps as ``base`` defines them.
+
+    Examples
+    --------
+    >>> from eulerpoisson.solvers.registry import Method, overrides
+    >>> class Mine(Method):
+    ...     def run(self, problem):
+    ...         raise NotImplementedError
+    >>> overrides(Mine(), Method, ("run",)), overrides(Mine(), Method, ("for_batch",))
+    (True, False)
+    """
+    cls = type(method)
+    return any(getattr(cls, n) is not getattr(base, n) for n in names)
 
 
 class Method:

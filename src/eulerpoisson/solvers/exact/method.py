@@ -42,7 +42,7 @@ from ...errors import InvalidInputError
 from ...numerics.quaternion import qmul
 from ...util import jit
 from ..problem import Problem, compose_initial, left_composed
-from ..registry import Method, MethodOptions, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, overrides, register_method
 
 __all__ = ["Exact"]
 
@@ -195,7 +195,7 @@ class Exact(Method):
         """
         if self._path is not None:
             return self._path
-        return _free_path_of(math.prod(problem.batch_shape), problem.t.shape[0])
+        return _free_path_from(self.numpy_estimate(problem), self.python_estimate(problem))
 
     def _use_compiled(self, problem: Problem) -> bool:
         return self._compiled if self._compiled is not None else jit.use_compiled(self.numpy_estimate(problem))
@@ -216,10 +216,13 @@ class Exact(Method):
         what :meth:`run` computes for it, without the problem."""
         from .motion import exact_motion_unchecked as exact_motion
 
-        if not _all_identity(body.principal_axes):
-            return None
+        hooks = ("run", "for_batch", "numpy_estimate", "python_estimate", "_free_path")
+        if not _all_identity(body.principal_axes) or overrides(self, Exact, hooks):
+            return None  # (a subclass that decides or runs otherwise: the general route, through its own methods)
         T = t.shape[0]
-        path = self._path if self._path is not None else _free_path_of(1, T)
+        path = (
+            self._path if self._path is not None else _free_path_from(_numpy_seconds(1, T, True), _python_seconds(1, T))
+        )
         _check_phase(t, omega0)
         Ip = body.principal_moments
         Mp, q_rel = exact_motion(Ip, Ip * omega0, t, compiled={"compiled": True, "numpy": False}.get(path, path))
@@ -323,12 +326,11 @@ def _python_seconds(n_bodies: int, n_times: int) -> float:
     return 1.0e-4 * B + 1.1e-4 * B * T
 
 
-def _free_path_of(n_bodies: int, n_times: int) -> str:
-    """:meth:`Exact._free_path` for a free-body problem of this size."""
-    numpy_seconds = _numpy_seconds(n_bodies, n_times, True)
+def _free_path_from(numpy_seconds: float, python_seconds: float) -> str:
+    """:meth:`Exact._free_path` from the estimated seconds of the NumPy path and of the plain-Python kernel."""
     if jit.use_compiled(numpy_seconds):
         return "compiled"
-    if _python_seconds(n_bodies, n_times) < numpy_seconds:
+    if python_seconds < numpy_seconds:
         return "compiled" if jit.USE_NUMBA and jit.numba_active() else "python"
     return "numpy"
 

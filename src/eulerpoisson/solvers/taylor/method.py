@@ -104,7 +104,7 @@ from ...model.free_body import euler_coefficients
 from ...numerics.quaternion import qmul
 from ...util.validate import as_float_array, as_scalar
 from ..problem import Problem
-from ..registry import Method, MethodOptions, MethodResult, register_method
+from ..registry import Method, MethodOptions, MethodResult, overrides, register_method
 from . import kernels as _k
 
 __all__ = [
@@ -114,13 +114,14 @@ __all__ = [
     "integrate_principal",
     "auto_order",
     "DEFAULT_FIXED_ORDER",
+    "TAYLOR_CHART_THRESHOLD",
 ]
 
 #: Taylor order used in fixed-step mode (``dt`` given) when ``order`` is None
 DEFAULT_FIXED_ORDER = 4
 
-#: the default ``chart_threshold``: the chart is re-centred when :math:`|\mathbf n|` exceeds it (the module notes)
-DEFAULT_CHART_THRESHOLD = 0.5
+#: taylor's default ``chart_threshold`` (rk and symplectic: charts.DEFAULT_CHART_THRESHOLD): the chart is re-centred when :math:`|\mathbf n|` exceeds it (the module notes)
+TAYLOR_CHART_THRESHOLD = 0.5
 #: largest accepted Taylor order
 MAX_ORDER = 200
 
@@ -344,7 +345,7 @@ def integrate_principal(
     order=None,
     dt=None,
     max_steps=1_000_000,
-    chart_threshold=DEFAULT_CHART_THRESHOLD,
+    chart_threshold=TAYLOR_CHART_THRESHOLD,
     backend="auto",
     lanes=None,
 ):
@@ -377,7 +378,7 @@ def integrate_principal(
         Maximum number of steps per body (both time directions together).
     chart_threshold : float
         Chart change when :math:`|\mathbf n|` exceeds it at the end of a step (>= 0; default
-        :data:`DEFAULT_CHART_THRESHOLD`).
+        :data:`TAYLOR_CHART_THRESHOLD`).
     backend : {"auto", "numba", "numpy"}
         ``"auto"``: compiled kernels for float64 when numba is in use
         (see :data:`~eulerpoisson.solvers.taylor.kernels.USE_NUMBA`),
@@ -533,7 +534,7 @@ class TaylorOptions(MethodOptions):
     order: int | None = None
     dt: float | None = None
     max_steps: int = 1_000_000
-    chart_threshold: float = DEFAULT_CHART_THRESHOLD
+    chart_threshold: float = TAYLOR_CHART_THRESHOLD
     precision: str = "float64"
     dps: int = 30
 
@@ -692,8 +693,12 @@ class Taylor(Method):
         """One free body in float64 with a diagonal tensor (the quick lane, :meth:`Method.run_one`): what
         :meth:`run` computes for it, without the problem (one body: never the lane kernel, one thread)."""
         c = self.config
-        if c["precision"] != "float64" or not body.is_diagonal:
-            return None
+        if (
+            c["precision"] != "float64"
+            or not body.is_diagonal
+            or overrides(self, Taylor, ("run", "for_batch", "_integrate"))
+        ):
+            return None  # (a subclass that runs otherwise: the general route, through its own methods)
         q, om, stats = self._integrate(
             body.principal_moments.reshape(1, 3), omega0[None], q0[None], t, 1 >= _k.LANES_MIN_BODIES
         )

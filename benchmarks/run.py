@@ -713,7 +713,7 @@ def speed_table(goals: list[dict], machine: dict) -> str:
         "|---|---|---|",
     ]
     for g in goals:
-        measured = str(g["measured"]).replace("|", "/")
+        measured = str(g["measured"]).replace("|", "\\|")
         lines.append(f"| {g['goal']} | {measured} | {g['status'].lower()} |")
     return "\n".join(lines)
 

@@ -44,21 +44,9 @@ import time
 from pathlib import Path
 
 EXE = str(Path(sys.executable).with_name("eulerpoisson"))
-SMALL = [
-    "simulate",
-    "--inertia",
-    "1,2,3",
-    "--omega",
-    "1,0.1,0.5",
-    "--t-end",
-    "10",
-    "--samples",
-    "1001",
-    "--out",
-    "x.nc",
-    "--overwrite",
-    "--quiet",
-]
+#: the reference body's command line up to its end time (the issue's small problem and the first-simulate rows)
+BODY = ["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end"]
+SMALL = [*BODY, "10", "--samples", "1001", "--out", "x.nc", "--overwrite", "--quiet"]
 #: the methods of the first-simulate rows; rk (scipy's solve_ivp stepper) is reported, not judged
 METHODS = ("exact", "taylor", "symplectic", "rk")
 
@@ -66,23 +54,8 @@ METHODS = ("exact", "taylor", "symplectic", "rk")
 def first_simulate(method: str, quick: bool = False) -> list[str]:
     """The command line (after ``eulerpoisson``) of the first-simulate row of ``method``: 10^5 samples to t = 1000
     (``quick``: 1000 samples to t = 10, which costs the new process and numba's start but little else)."""
-    return [
-        "simulate",
-        "--inertia",
-        "1,2,3",
-        "--omega",
-        "1,0.1,0.5",
-        "--t-end",
-        "10" if quick else "1000",
-        "--samples",
-        "1000" if quick else "100000",
-        "--method",
-        method,
-        "--out",
-        "y.nc",
-        "--overwrite",
-        "--quiet",
-    ]
+    t_end, samples = ("10", "1000") if quick else ("1000", "100000")
+    return [*BODY, t_end, "--samples", samples, "--method", method, "--out", "y.nc", "--overwrite", "--quiet"]
 
 
 def _env(**extra):

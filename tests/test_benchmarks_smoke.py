@@ -296,7 +296,10 @@ def test_test_suite_parsing_and_environment():
     assert env == {"PATH": "/bin", "HOME": "/h"}
 
 
-@pytest.mark.skipif(shutil.which("git") is None or shutil.which("make") is None, reason="needs git and make")
+@pytest.mark.skipif(
+    shutil.which("git") is None or shutil.which("make") is None,
+    reason="the test-suite benchmark clones with git and runs make: git or make is not on PATH here",
+)
 @pytest.mark.parametrize("case", ["ok", "failed", "timed out"])
 def test_test_suite_on_a_throwaway_repository(case, tmp_path, monkeypatch):
     """bench_test_suite.run clones a repository and times its ``make test``, which here only prints."""

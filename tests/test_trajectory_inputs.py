@@ -353,3 +353,29 @@ def test_from_particles_out_of_range_messages():
         RigidBody.from_particles([1.0, 1.0, 1.0], 1e-200 * pos)
     with pytest.raises(InvalidInputError, match="overflows float64"):
         RigidBody.from_particles([1.0, 1.0, 1.0], 1e154 * pos)  # entries fit, the largest moment does not
+
+
+@pytest.mark.parametrize("where", ["quaternion", "omega"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_stored_attitudes_refuses_a_non_finite_value_of_a_few_samples(where, bad):
+    # (a few samples are checked in plain floats, the rest by as_float_array: the same errors)
+    from eulerpoisson.trajectory import stored_attitudes
+
+    t = np.array([0.0, 1.0])
+    q = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+    w = np.ones((2, 3))
+    (q if where == "quaternion" else w)[1, 2] = bad
+    with pytest.raises(InvalidInputError, match=f"{where} contains NaN or infinite values"):
+        stored_attitudes(t, q, w)
+
+
+def test_stored_attitudes_of_huge_finite_values_is_the_checked_result():
+    # finite values whose sum overflows: the checked path stores them, it does not refuse them
+    from eulerpoisson.trajectory import stored_attitudes
+
+    t = np.array([0.0, 1.0])
+    q = np.array([[2.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, -3.0]])
+    w = np.full((2, 3), 1e308)
+    got = stored_attitudes(t, q, w)
+    assert np.array_equal(got, Trajectory(t, q, w, RigidBody([1.0, 2.0, 3.0])).quaternion)
+    assert np.array_equal(got, [[1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, -1.0]])

@@ -48,6 +48,7 @@ CONVENTIONS = (
 _UNIT_SLACK = 4 * float(np.finfo(float).eps)
 #: at most this many samples are checked in plain floats
 _FEW = 8
+_FLOAT64 = np.dtype(np.float64)
 
 
 def _unit_continuous(t: np.ndarray, q: np.ndarray, continuous: bool = True) -> np.ndarray:
@@ -102,6 +103,20 @@ def stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
         As :class:`Trajectory` (the driver then builds the trajectory of the whole batch again, so that the
         message is about the whole batch).
     """
+    if (
+        type(quaternion) is np.ndarray
+        and type(omega) is np.ndarray
+        and quaternion.ndim == 2
+        and quaternion.shape[0] <= _FEW
+        and quaternion.dtype == _FLOAT64
+        and omega.dtype == _FLOAT64
+        and quaternion.shape[1:] == (4,)
+        and omega.shape[-1:] == (3,)
+        and math.isfinite(sum(quaternion.ravel().tolist()) + sum(omega.ravel().tolist()))
+    ):
+        # a few samples whose values are all finite (an infinite or NaN one makes the sum so): the checks in
+        # plain floats (the sum, not each value, to spare Python calls)
+        return _unit_continuous(t, quaternion)
     q = as_float_array(quaternion, "quaternion", (4,))
     as_float_array(omega, "omega", (3,))
     return _unit_continuous(t, q)
@@ -235,6 +250,32 @@ class Trajectory:
         self.method = method
         self.options = dict(options or {})
         self.stats = dict(stats or {})
+
+    @classmethod
+    def _assembled(
+        cls,
+        t: np.ndarray,
+        quaternion: np.ndarray,
+        omega: np.ndarray,
+        model: Model,
+        method: str,
+        options: dict[str, Any],
+        stats: dict[str, Any],
+    ) -> Trajectory:
+        """The trajectory that ``Trajectory(t, quaternion, omega, model.body, method, options, stats,
+        torque=model.torques, _prepared=True)`` makes, without its checks (for the solve driver's quick lane,
+        which has made every part as that call would: ``t`` a float64 array (T,), ``quaternion`` and ``omega``
+        returned by :func:`stored_attitudes` and checked by it, ``model`` of one free body)."""
+        self = cls.__new__(cls)
+        self.t = t
+        self.omega = omega
+        self.quaternion = quaternion
+        self.body = model.body
+        self.model = model
+        self.method = method
+        self.options = dict(options)
+        self.stats = dict(stats)
+        return self
 
     # ------------------------------------------------------------------
     @property

@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..model.body import RigidBody, cached_body
 from ..model.equations import Model
-from ..trajectory import Trajectory
+from ..trajectory import Trajectory, stored_attitudes
 from ..util.jit import run_shape, whole_run
 from . import engine
 from .parallel import ENV_WORKERS, resolve_workers, solve_batch
@@ -221,6 +221,17 @@ def quick_solve(
             problem = Problem(model=model, q0=q0, omega0=wa, t=tt)
             m = m.for_batch(problem)
             res = solve_batch(m, problem, None)
+    stats = {"wall_time": 0.0, **res.stats}
+    q, om = res.q, res.omega
+    if type(q) is np.ndarray and type(om) is np.ndarray and q.shape == (n, 4) and om.shape == (n, 3):
+        # what Trajectory makes of them (stored_attitudes: checked, normalized, signs continuous), without
+        # its checks of the parts this lane made
+        if not res.prepared:
+            q = stored_attitudes(tt, q, om)
+        if q.dtype == _FLOAT64 and om.dtype == _FLOAT64:
+            tr = Trajectory._assembled(tt, q, om, model, name, m.config, stats)
+            tr.stats["wall_time"] = _time.perf_counter() - start
+            return tr
     tr = Trajectory(
         t=tt,
         quaternion=res.q,
@@ -229,7 +240,7 @@ def quick_solve(
         torque=model.torques,
         method=name,
         options=dict(m.config),
-        stats={"wall_time": 0.0, **res.stats},
+        stats=stats,
         _prepared=res.prepared,
     )
     tr.stats["wall_time"] = _time.perf_counter() - start

@@ -176,6 +176,8 @@ def overrides(method: object, base: type, names: tuple[str, ...]) -> bool:
     (True, False)
     """
     cls = type(method)
+    if cls is base:
+        return False
     return any(getattr(cls, n) is not getattr(base, n) for n in names)
 
 

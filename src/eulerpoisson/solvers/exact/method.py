@@ -214,21 +214,17 @@ class Exact(Method):
     def run_one(self, body, q0, omega0, t) -> MethodResult | None:
         """One free body whose principal frame is the body frame (the quick lane, :meth:`Method.run_one`):
         what :meth:`run` computes for it, without the problem."""
-        from .motion import exact_motion_unchecked as exact_motion
-
-        hooks = ("run", "for_batch", "numpy_estimate", "python_estimate", "_free_path")
-        if not _all_identity(body.principal_axes) or overrides(self, Exact, hooks):
+        if not _all_identity(body.principal_axes) or overrides(self, Exact, _RUN_HOOKS):
             return None  # (a subclass that decides or runs otherwise: the general route, through its own methods)
         T = t.shape[0]
-        path = (
-            self._path if self._path is not None else _free_path_from(_numpy_seconds(1, T, True), _python_seconds(1, T))
-        )
+        path = self._path if self._path is not None else _one_body_path(T)
         _check_phase(t, omega0)
         Ip = body.principal_moments
-        Mp, q_rel = exact_motion(Ip, Ip * omega0, t, compiled={"compiled": True, "numpy": False}.get(path, path))
+        motion = _MOTION if _MOTION is not None else _motion()
+        Mp, q_rel = motion.one_body_motion(Ip, Ip * omega0, t, compiled=_COMPILED_ARG.get(path, path))
         return MethodResult(
             q=left_composed(q0, q_rel),
-            omega=Mp / Ip[..., None, :],
+            omega=Mp / Ip,
             stats={"evaluations": T, "compiled": path == "compiled" and jit.USE_NUMBA, "threads": 1},
         )
 
@@ -314,7 +310,11 @@ class Exact(Method):
 
 def _numpy_seconds(n_bodies: int, n_times: int, free: bool) -> float:
     """:meth:`Exact.numpy_estimate` for a problem of this size (the whole run's size decides, :func:`~eulerpoisson.util.jit.run_shape`)."""
-    B, T = jit.run_shape(n_bodies, n_times)
+    return _numpy_cost(*jit.run_shape(n_bodies, n_times), free)
+
+
+def _numpy_cost(B: int, T: int, free: bool) -> float:
+    """Seconds of the NumPy path for a run of ``B`` bodies at ``T`` times."""
     if not free:
         return 5e-3 + 20e-6 * B + 2.5e-6 * B * T
     return 2e-3 + 8e-6 * B + 2e-6 * B * T
@@ -322,8 +322,36 @@ def _numpy_seconds(n_bodies: int, n_times: int, free: bool) -> float:
 
 def _python_seconds(n_bodies: int, n_times: int) -> float:
     """:meth:`Exact.python_estimate` for a problem of this size."""
-    B, T = jit.run_shape(n_bodies, n_times)
+    return _python_cost(*jit.run_shape(n_bodies, n_times))
+
+
+def _python_cost(B: int, T: int) -> float:
+    """Seconds of the scalar kernel as plain Python for a run of ``B`` bodies at ``T`` times."""
     return 1.0e-4 * B + 1.1e-4 * B * T
+
+
+_MOTION = None
+
+
+def _motion():
+    """The module of the closed form (imported on first use, not with the package)."""
+    global _MOTION
+    from . import motion
+
+    _MOTION = motion
+    return motion
+
+
+#: the methods through which the exact method decides and runs: a subclass redefining one takes the general route
+_RUN_HOOKS = ("run", "for_batch", "numpy_estimate", "python_estimate", "_free_path")
+#: the ``compiled`` argument of the kernels' entry points for each path
+_COMPILED_ARG = {"compiled": True, "numpy": False}
+
+
+def _one_body_path(n_times: int) -> str:
+    """:meth:`Exact._free_path` of one body at ``n_times`` times (the whole run's size decides)."""
+    B, T = jit.run_shape(1, n_times)
+    return _free_path_from(_numpy_cost(B, T, True), _python_cost(B, T))
 
 
 def _free_path_from(numpy_seconds: float, python_seconds: float) -> str:
@@ -346,12 +374,15 @@ _IDENTITY9 = np.eye(3).reshape(9)
 
 def _all_identity(frames) -> bool:
     """Whether every 3x3 matrix of ``frames`` (shape ``(..., 3, 3)``) is the identity, exactly."""
-    if np.ndim(frames) == 2:  # one matrix: plain floats
+    if type(frames) is np.ndarray and frames.ndim == 2:  # one matrix: plain floats
+        return frames.tolist() == _IDENTITY33_LIST
+    if np.ndim(frames) == 2:
         return np.ravel(frames).tolist() == _IDENTITY9_LIST
     return bool((np.reshape(frames, (-1, 9)) == _IDENTITY9).all())
 
 
 _IDENTITY9_LIST = _IDENTITY9.tolist()
+_IDENTITY33_LIST = np.eye(3).tolist()
 
 
 def _principal_frame(problem: Problem) -> bool:

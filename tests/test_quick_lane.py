@@ -57,8 +57,8 @@ CASES = [
 @pytest.mark.parametrize(("method", "options"), CASES)
 @pytest.mark.parametrize(
     "t",
-    [0.0, 3, [0.0], [0.0, 1.0, 2.5], (2.5, -1.0, 0.0, 2.5), np.array([4.0, -0.5]), [1e3]],
-    ids=["zero", "int", "list1", "list", "tuple-unsorted", "array", "far"],
+    [0.0, 3, [0.0], [0.0, 1.0, 2.5], (2.5, -1.0, 0.0, 2.5), np.array([4.0, -0.5]), [1e3], np.linspace(0.0, 20.0, 30)],
+    ids=["zero", "int", "list1", "list", "tuple-unsorted", "array", "far", "30-times"],  # (30: exact's NumPy path)
 )
 def test_the_quick_lane_gives_the_general_result(method, options, t):
     kw = dict(omega0=[1.0, 0.1, 0.5], method=method, **options)

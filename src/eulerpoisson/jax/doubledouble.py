@@ -47,6 +47,7 @@ __all__ = [
     "dd_sqrt",
     "safe_sqrt",
     "straight",
+    "exp2i",
 ]
 
 
@@ -158,3 +159,30 @@ def straight(value, new):
     AGM at ``m = 0`` gives ``dK/dm = 0`` instead of ``pi/8``).
     """
     return jax.lax.stop_gradient(value) + (new - jax.lax.stop_gradient(new))
+
+
+def exp2i(e, dtype):
+    """``2**e`` exactly, for integer ``e`` (an array) in ``dtype`` (float64 or float32), without ``pow``.
+
+    Built from the bits of two powers of two, ``2**(e//2) * 2**(e - e//2)`` (each a normal number
+    for ``|e|`` up to twice the largest exponent): the product is exact, ``inf`` above the largest
+    power and 0 below the smallest subnormal one, as ``2.0**e``. (``jnp.ldexp`` is a ``pow``, costly
+    on a GPU; this is two integer shifts and a product.)
+
+    Examples
+    --------
+    >>> import jax.numpy as jnp
+    >>> from eulerpoisson.jax.doubledouble import exp2i
+    >>> [float(v) for v in exp2i(jnp.array([-3, 0, 10]), jnp.float32)]
+    [0.125, 1.0, 1024.0]
+    """
+    f64 = jnp.dtype(dtype) == jnp.float64
+    itype, bias, mant = (jnp.int64, 1023, 52) if f64 else (jnp.int32, 127, 23)
+    e = jnp.asarray(e).astype(itype)
+    lo = jnp.clip(e, -2 * bias + 2, 2 * bias) // 2
+    hi = jnp.clip(e, -2 * bias + 2, 2 * bias) - lo
+
+    def bits(k):
+        return jax.lax.bitcast_convert_type(jnp.left_shift(k + bias, mant).astype(itype), dtype)
+
+    return bits(lo) * bits(hi)

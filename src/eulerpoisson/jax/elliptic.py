@@ -63,6 +63,7 @@ from .doubledouble import (
     dd_div,
     dd_mul,
     dd_sqrt,
+    exp2i,
     quick_two_sum,
     safe_sqrt,
     straight,
@@ -384,10 +385,9 @@ def _sncndn_real(vn, dv, P: JacobiParams):
     return s, c
 
 
-def _sncndn_imag(vn, dv, P: JacobiParams):
-    """Landen ascent on the imaginary axis for the complementary parameter (``m > 1/2``)."""
-    sh = jnp.sinh(vn)
-    ch = jnp.cosh(vn)
+def _sncndn_imag(sh, ch, dv, P: JacobiParams):
+    """Landen ascent on the imaginary axis for the complementary parameter (``m > 1/2``), from
+    ``sh, ch = sinh, cosh`` of the scaled argument."""
     sig = sh + ch * dv
     Cc = ch + sh * dv
 
@@ -406,11 +406,6 @@ def _sncndn_imag(vn, dv, P: JacobiParams):
     return sig / Cc, 1.0 / Cc
 
 
-def _sech(x):
-    e = jnp.exp(-x)
-    return 2.0 * e / (1.0 + e * e)
-
-
 def _sncndn_core(r, rl, P: JacobiParams):
     """sn, cn, dn of a reduced argument ``r + rl`` (sn signed)."""
     neg = r < 0.0
@@ -424,15 +419,23 @@ def _sncndn_core(r, rl, P: JacobiParams):
     vr = jnp.where(P.imag, 0.5, vn)
     vi = jnp.where(P.imag & ~P.sep, vn, 0.5)
     sr, cr = _sncndn_real(vr, jnp.where(P.imag, 0.0, dv), P)
-    si, ci = _sncndn_imag(vi, jnp.where(P.imag & ~P.sep, dv, 0.0), P)
+    # one expm1 per element for the imaginary path (sinh, cosh of vi <~ 120) and the separatrix (tanh, sech
+    # of the unreduced v, any size): with g = exp(-x) - 1, e = exp(-x),
+    # sinh x = -g (2 + g)/(2 e), cosh x = (1 + e^2)/(2 e), tanh x = -g (2 + g)/(1 + e^2), sech x = 2 e/(1 + e^2)
+    g = jnp.expm1(-jnp.where(P.sep, v, vi))
+    gi = jnp.where(P.sep, -0.5, g)  # (safe: e = 1/2)
+    ei = 1.0 + gi
+    hi = 0.5 / ei
+    si, ci = _sncndn_imag(-gi * (2.0 + gi) * hi, (1.0 + ei * ei) * hi, jnp.where(P.imag & ~P.sep, dv, 0.0), P)
     s = jnp.where(P.imag, si, sr)
     c = jnp.where(P.imag, ci, cr)
     s2 = s * s
     d = jnp.sqrt(jnp.where(P.m <= 0.5, 1.0 - P.m * s2, c * c + P.m1 * s2))
     # separatrix m = 1: tanh / sech of the unreduced argument
-    vs = jnp.where(P.sep, v, 0.0)
-    sech = _sech(vs)
-    s = jnp.where(P.sep, jnp.tanh(vs), s)
+    e = 1.0 + g
+    den = 1.0 / (1.0 + e * e)
+    sech = 2.0 * e * den
+    s = jnp.where(P.sep, -g * (2.0 + g) * den, s)
     c = jnp.where(P.sep, sech, c)
     d = jnp.where(P.sep, sech, d)
     return jnp.where(neg, -s, s), c, d
@@ -482,6 +485,27 @@ def _rc1(e, y, C: Consts):
     return jnp.where(small, _rc1_series(e), jnp.where(pos, vpos, jnp.where(neg, vneg, 1.0)))
 
 
+#: the short R_J loop's closed steps: halvings of R_C's argument in each (see _rc1_halved)
+_RC_HALVINGS = (3, 2)
+
+
+def _rc1_halved(e, y, halvings, C: Consts):
+    """``(R_C(1, y), ok)``, ``y = 1 + e``, without a transcendental: ``halvings`` times the duplication
+    ``g(e) = 2/(1 + s) g(e/(1 + s)^2)``, ``s = sqrt(y)`` (``g(e) = R_C(1, 1 + e)``; ``atan t = 2 atan(t/(1 +
+    sqrt(1 + t^2)))`` and the same for ``atanh``), with ``y' = 2 s/(1 + s)`` kept accurate, then the series.
+    ``ok``: the argument reached the series' range (elsewhere the value is wrong). Three halvings take
+    ``-0.79 <= e <= 3`` (at least) there (the closed forms of :func:`_rc1` cost an ``atan`` and a ``log1p``).
+    """
+    fac = jnp.ones_like(e)
+    for _ in range(halvings):
+        s = jnp.sqrt(y)
+        r = 1.0 / (1.0 + s)
+        fac = fac * (2.0 * r)
+        e = e * (r * r)
+        y = 2.0 * s * r
+    return fac * _rc1_series(e), jnp.abs(e) <= C.rc_series
+
+
 def rf(x, y, z):
     """Carlson's ``R_F`` for non-negative arguments, at most one zero (no checks)."""
     C = _c(x)
@@ -529,8 +553,9 @@ def _rj_delta(x, y, z, p, C: Consts):
     e1 = jnp.where(tiny & (jnp.abs(f1) < 0.5), -_frexp_exp(f1), 0)
     e2 = jnp.where(tiny & (jnp.abs(f2) < 0.5), -_frexp_exp(f2), 0)
     e1 = e1 + jnp.mod(e1 + e2, 2)
-    delta = jnp.where(tiny, jnp.ldexp(f1, e1) * jnp.ldexp(f2, e2) * f3, delta)
-    sc = jnp.where(tiny, jnp.ldexp(jnp.ones_like(delta), jnp.floor_divide(e1 + e2, 2)), 1.0)
+    # (exact scalings by powers of two: jnp.ldexp would be a pow)
+    delta = jnp.where(tiny, (f1 * exp2i(e1, f1.dtype)) * (f2 * exp2i(e2, f2.dtype)) * f3, delta)
+    sc = jnp.where(tiny, exp2i(jnp.floor_divide(e1 + e2, 2), delta.dtype), 1.0)
     return delta, sc
 
 
@@ -541,7 +566,9 @@ def _keep(act, st):
 def _rj_step(act, st, C: Consts, delta, sc, closed=True):
     """One duplication step of ``R_J`` on the elements ``act`` (and ``e``, the argument of its ``R_C``).
 
-    ``closed=False``: ``R_C`` by its series alone (right where ``|e| <= 2**-5``; see :func:`rj`).
+    ``closed=False``: ``R_C`` by its series alone (right where ``|e| <= 2**-5``; see :func:`rj`); an int:
+    by that many halvings and the series (:func:`_rc1_halved`). Returns the new state and ``e`` (with halvings:
+    0 where they sufficed, 1 where not).
     """
     a, fac, x, y, z, p, acc = st
     sx, sy, sz, sp = safe_sqrt(x), safe_sqrt(y), safe_sqrt(z), safe_sqrt(p)
@@ -551,7 +578,10 @@ def _rj_step(act, st, C: Consts, delta, sc, closed=True):
     e = (fac * fac * fac) * delta / (dd * dd)
     y1 = 2.0 * sp * (p + lam) / d
     # the closed forms (atan, log1p: the costly part) only when an element needs them
-    if not closed:
+    if closed is not True and closed:
+        rc, ok = _rc1_halved(e, y1, closed, C)
+        e = jnp.where(ok, 0.0, 1.0)
+    elif not closed:
         rc = _rc1_series(e)
     elif fused_loops():
         rc = _rc1(e, y1, C=C)
@@ -634,18 +664,19 @@ def _rj_a0(x, y, z, p):
 def _rj_short(x, y, z, p, C: Consts):
     """The common case in fewer operations: ``(value, redo)``.
 
-    ``C.rj_closed`` steps with the closed forms of ``R_C``, then series-only steps up to
-    ``C.rj_short`` in all. Where neither sufficed (``redo``: a later step with ``|e| > 2**-5``, or
-    not converged), the value is wrong and the element must be recomputed by :func:`_rj_all`;
-    elsewhere it is the value of :func:`_rj_all`, bit for bit (the same operations).
+    ``C.rj_closed`` steps with ``R_C`` by halvings of its argument and its series (:data:`_RC_HALVINGS`;
+    no transcendental), then series-only steps up to ``C.rj_short`` in all. Where neither sufficed
+    (``redo``: an argument out of reach of the halvings, a later step with ``|e| > 2**-5``, or not
+    converged), the value is wrong and the element must be recomputed by :func:`_rj_all`; elsewhere it
+    is the value of :func:`_rj_all` to an ulp or two (the same steps, ``R_C`` computed otherwise).
     """
     st, delta, sc, q = _rj_start(x, y, z, p, C)
     redo = jnp.zeros(x.shape, bool)
     for k in range(C.rj_short):
         act = st[1] * q >= jnp.abs(st[0])
-        st, e = _rj_step(act, st, C=C, delta=delta, sc=sc, closed=k < C.rj_closed)
-        if k >= C.rj_closed:
-            redo = redo | (act & (jnp.abs(e) > C.rc_series))
+        closed = _RC_HALVINGS[min(k, len(_RC_HALVINGS) - 1)] if k < C.rj_closed else False
+        st, e = _rj_step(act, st, C=C, delta=delta, sc=sc, closed=closed)
+        redo = redo | (act & (jnp.abs(e) > C.rc_series))
     redo = redo | (st[1] * q >= jnp.abs(st[0]))
     return _rj_end(x, y, z, _rj_a0(x, y, z, p), st), redo
 
@@ -655,7 +686,8 @@ def rj(x, y, z, p):
 
     In the fused form (GPUs) a large batch takes the short loop of :func:`_rj_short` (``R_J``'s
     duplication shrinks the argument ``e`` of its ``R_C`` terms 64-fold per step: the closed forms
-    matter in the first steps only, and 8 steps suffice for almost every argument) and recomputes the
+    matter in the first steps only, where halvings of ``e`` and the series replace them, and 8 steps
+    suffice for almost every argument) and recomputes the
     few elements that need more with the full loop (gathered into a buffer of 1/16 of the batch; the
     whole batch again if they do not fit). Which loop gives an element's value depends on that
     element alone, never on the rest of the batch (the two agree to an ulp or two: XLA contracts

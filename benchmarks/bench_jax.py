@@ -189,8 +189,10 @@ def agreement(n: int = 2000):
     }
 
 
-def run(quick: bool = False, log=print, evaluations: float | None = None) -> dict:
-    """All rows; ``evaluations`` defaults to 1e8 on a GPU and 1e6 on the CPU (1e4 with ``quick``)."""
+def run(quick: bool = False, log=print, evaluations: float | None = None, rates_only: bool = False) -> dict:
+    """All rows; ``evaluations`` defaults to 1e8 on a GPU and 1e6 on the CPU (1e4 with ``quick``);
+    ``rates_only``: the two rates alone (not the agreement and float32 rows, which compile programs of their
+    own: for a short lease of a GPU)."""
     import _common as C
 
     dev = _device()
@@ -215,6 +217,9 @@ def run(quick: bool = False, log=print, evaluations: float | None = None) -> dic
         rows["jax_cpu_slowdown_vs_numba"] = ratio
         log(f"numba exact kernel: {r['rate_per_s']:.3g} /s; JAX float64 on the CPU takes {ratio:.2f}x its time")
         rows["gpu"] = "pending: no GPU at hand (run this script on one: see benchmarks/README.md)"
+    if rates_only:
+        rows["agreement_float64_vs_numpy"] = rows["float32_error"] = "not measured in this run (--rates-only)"
+        return C.envelope("jax", quick=quick, command=C.command_line(), machine=C.machine_info(), results=rows)
     rows["agreement_float64_vs_numpy"] = agreement(100 if quick else 2000)
     log(f"float64 vs the NumPy path: {rows['agreement_float64_vs_numpy']}")
     rows["float32_error"] = float32_error(200 if quick else 2000)
@@ -226,12 +231,15 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--evaluations", type=float, default=None, help="evaluations per row (default 1e8 GPU, 1e6 CPU)")
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument(
+        "--rates-only", action="store_true", help="the two rates alone (no agreement or float32-error rows)"
+    )
     ap.add_argument("--out", type=Path, default=HERE / "results", help="folder for jax.json (default: results/)")
     ap.add_argument("--name", default=None, help="file name (default jax.json on the CPU, jax_gpu.json on a GPU)")
     args = ap.parse_args(argv)
     import _common as C
 
-    payload = run(args.quick, evaluations=args.evaluations)
+    payload = run(args.quick, evaluations=args.evaluations, rates_only=args.rates_only)
     gpu = payload["results"]["jax_exact_float64"]["platform"] == "gpu"
     name = args.name or ("jax_gpu.json" if gpu else "jax.json")
     C.write_json(args.out / name, payload)

@@ -353,57 +353,50 @@ def _loop(steps, body, state):
     return jax.lax.fori_loop(0, steps, body, state)
 
 
-def _sncndn_real(vn, dv, P: JacobiParams):
-    """Landen ascent on the real axis (``m <= 1/2``; ``vn <= pi/4``, the polynomials)."""
+def _sncndn_ascent(vn, dv, sh, ch, dvi, P: JacobiParams):
+    """The Landen ascents, real (``m <= 1/2``; ``vn <= pi/4``, the polynomials) and imaginary (``m > 1/2``, the
+    complementary parameter, from ``sh, ch = sinh, cosh`` of the scaled argument), in one loop whose
+    coefficients are selected per element: ``(s, c)`` of the level-0 amplitude.
+
+    Real: ``s' = (1 + k) s/(1 + k s^2)``, ``c' = c sqrt(c^2 + k1^2 s^2)/(1 + k s^2)``, with ``y = 1 - c`` kept
+    accurate near the real axis; imaginary: ``sigma' = (1 + k) sigma/(1 - k sigma^2)``, ``C' = C sqrt(1 + k^2
+    sigma^2)/(1 - k sigma^2)`` (``sn = sigma/C``, ``cn = 1/C``). One square root and one reciprocal per level.
+    """
+    imag = P.imag
     s0 = _sin_poly(vn)
     c0 = _cos_poly(vn)
     h = _sin_poly(0.5 * vn)
-    s = s0 + c0 * dv
-    c = c0 - s0 * dv
-    y = 2.0 * h * h + s0 * dv
+    s = jnp.where(imag, sh + ch * dvi, s0 + c0 * dv)
+    c = jnp.where(imag, ch + sh * dvi, c0 - s0 * dv)
+    y = jnp.where(imag, 1.0, 2.0 * h * h + s0 * dv)
+    sgn = jnp.where(imag, -1.0, 1.0)
 
     def level(k, st):
         s, c, y = st
         i = LANDEN_LEVELS - 1 - k
         sq = _level(P.sqm, i)
         s2 = s * s
-        ce = jnp.where(y < 0.5, 1.0 - y, c)
-        d = jnp.sqrt(ce * ce + _level(P.pcl, i) * s2)
-        den = 1.0 + sq * s2
+        ry = (y < 0.5) & ~imag
+        ce = jnp.where(ry, 1.0 - y, c)
+        d = jnp.sqrt(jnp.where(imag, 1.0, ce * ce) + jnp.where(imag, sq * sq, _level(P.pcl, i)) * s2)
+        den = 1.0 + sgn * (sq * s2)
+        # one reciprocal for 1/den and 1/(1 + d)
+        opd = 1.0 + d
+        rr = 1.0 / (den * opd)
+        r = rr * opd
         use = sq > 0.0
-        s_new = (1.0 + sq) * s / den
-        c_new = ce * d / den
-        y_new = (y + ce * (sq * sq * s2) / (1.0 + d) + sq * s2) / den
+        s_new = (1.0 + sq) * s * r
+        c_new = ce * d * r
+        y_new = (y + ce * (sq * sq * s2) * (rr * den) + sq * s2) * r
         return (
             jnp.where(use, s_new, straight(s, s_new)),
             jnp.where(use, c_new, straight(c, c_new)),
-            jnp.where(use, y_new, straight(y, y_new)),
+            jnp.where(use & ~imag, y_new, straight(y, y_new)),
         )
 
     s, c, y = _loop(LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(s, c, y, P.m)[:3]))
-    c = jnp.where(y < 0.5, 1.0 - y, c)
-    return s, c
-
-
-def _sncndn_imag(sh, ch, dv, P: JacobiParams):
-    """Landen ascent on the imaginary axis for the complementary parameter (``m > 1/2``), from
-    ``sh, ch = sinh, cosh`` of the scaled argument."""
-    sig = sh + ch * dv
-    Cc = ch + sh * dv
-
-    def level(k, st):
-        sig, Cc = st
-        sq = _level(P.sqm, LANDEN_LEVELS - 1 - k)
-        s2 = sig * sig
-        D = jnp.sqrt(1.0 + (sq * sq) * s2)
-        den = 1.0 - sq * s2
-        use = sq > 0.0
-        sig_new = (1.0 + sq) * sig / den
-        C_new = Cc * D / den
-        return jnp.where(use, sig_new, straight(sig, sig_new)), jnp.where(use, C_new, straight(Cc, C_new))
-
-    sig, Cc = _loop(LANDEN_LEVELS, level, tuple(jnp.broadcast_arrays(sig, Cc, P.m)[:2]))
-    return sig / Cc, 1.0 / Cc
+    rc = 1.0 / jnp.where(imag, c, 1.0)
+    return jnp.where(imag, s * rc, s), jnp.where(imag, rc, jnp.where(y < 0.5, 1.0 - y, c))
 
 
 def _sncndn_core(r, rl, P: JacobiParams):
@@ -412,28 +405,36 @@ def _sncndn_core(r, rl, P: JacobiParams):
     # (not jnp.abs: its derivative at r = 0 is 0)
     v = jnp.where(neg, -r, r)
     vl = jnp.where(neg, -rl, rl)
-    vq = v / P.ph
+    rph = 1.0 / P.ph
+    vq = v * rph
     vn = vq - vq * P.pcorr
-    dv = vl / P.ph
+    dv = vl * rph
     # each path with safe arguments where the other one (or the separatrix) is used
     vr = jnp.where(P.imag, 0.5, vn)
     vi = jnp.where(P.imag & ~P.sep, vn, 0.5)
-    sr, cr = _sncndn_real(vr, jnp.where(P.imag, 0.0, dv), P)
     # one expm1 per element for the imaginary path (sinh, cosh of vi <~ 120) and the separatrix (tanh, sech
     # of the unreduced v, any size): with g = exp(-x) - 1, e = exp(-x),
     # sinh x = -g (2 + g)/(2 e), cosh x = (1 + e^2)/(2 e), tanh x = -g (2 + g)/(1 + e^2), sech x = 2 e/(1 + e^2)
     g = jnp.expm1(-jnp.where(P.sep, v, vi))
     gi = jnp.where(P.sep, -0.5, g)  # (safe: e = 1/2)
     ei = 1.0 + gi
-    hi = 0.5 / ei
-    si, ci = _sncndn_imag(-gi * (2.0 + gi) * hi, (1.0 + ei * ei) * hi, jnp.where(P.imag & ~P.sep, dv, 0.0), P)
-    s = jnp.where(P.imag, si, sr)
-    c = jnp.where(P.imag, ci, cr)
+    e = 1.0 + g
+    ope2 = 1.0 + e * e
+    # one reciprocal for 1/(2 ei) and 1/(1 + e^2) (ei >= exp(-120) and e <= 1: no overflow)
+    rr = 1.0 / (ei * ope2)
+    hi = 0.5 * (rr * ope2)
+    s, c = _sncndn_ascent(
+        vr,
+        jnp.where(P.imag, 0.0, dv),
+        -gi * (2.0 + gi) * hi,
+        (1.0 + ei * ei) * hi,
+        jnp.where(P.imag & ~P.sep, dv, 0.0),
+        P,
+    )
     s2 = s * s
     d = jnp.sqrt(jnp.where(P.m <= 0.5, 1.0 - P.m * s2, c * c + P.m1 * s2))
     # separatrix m = 1: tanh / sech of the unreduced argument
-    e = 1.0 + g
-    den = 1.0 / (1.0 + e * e)
+    den = rr * ei
     sech = 2.0 * e * den
     s = jnp.where(P.sep, -g * (2.0 + g) * den, s)
     c = jnp.where(P.sep, sech, c)
@@ -444,9 +445,10 @@ def _sncndn_core(r, rl, P: JacobiParams):
 def _quadrant(n, s, c, d, kp):
     q = jnp.mod(n, 4.0)
     odd = (q == 1.0) | (q == 3.0)
-    sn = jnp.where(odd, c / d, s)
-    cn = jnp.where(odd, -(kp * s / d), c)
-    dn = jnp.where(odd, kp / d, d)
+    rd = 1.0 / d
+    sn = jnp.where(odd, c * rd, s)
+    cn = jnp.where(odd, -(kp * s * rd), c)
+    dn = jnp.where(odd, kp * rd, d)
     flip = q >= 2.0
     return jnp.where(flip, -sn, sn), jnp.where(flip, -cn, cn), dn
 
@@ -546,7 +548,8 @@ def _frexp_exp(x):
 
 
 def _rj_delta(x, y, z, p, C: Consts):
-    """``(delta, sc)``: ``(p-x)(p-y)(p-z)`` rescaled by powers of two against underflow."""
+    """``(delta, sc)``: ``(p-x)(p-y)(p-z)`` rescaled by powers of two against underflow (``sc``: the reciprocal
+    of the square root of the scaling, a power of two)."""
     f1, f2, f3 = p - x, p - y, p - z
     delta = f1 * f2 * f3
     tiny = (jnp.abs(delta) < C.delta_tiny) & (f1 != 0) & (f2 != 0) & (f3 != 0)
@@ -555,7 +558,7 @@ def _rj_delta(x, y, z, p, C: Consts):
     e1 = e1 + jnp.mod(e1 + e2, 2)
     # (exact scalings by powers of two: jnp.ldexp would be a pow)
     delta = jnp.where(tiny, (f1 * exp2i(e1, f1.dtype)) * (f2 * exp2i(e2, f2.dtype)) * f3, delta)
-    sc = jnp.where(tiny, exp2i(jnp.floor_divide(e1 + e2, 2), delta.dtype), 1.0)
+    sc = jnp.where(tiny, exp2i(-jnp.floor_divide(e1 + e2, 2), delta.dtype), 1.0)
     return delta, sc
 
 
@@ -574,9 +577,10 @@ def _rj_step(act, st, C: Consts, delta, sc, closed=True):
     sx, sy, sz, sp = safe_sqrt(x), safe_sqrt(y), safe_sqrt(z), safe_sqrt(p)
     lam = sx * sy + sy * sz + sz * sx
     d = (sp + sx) * (sp + sy) * (sp + sz)
-    dd = d * sc
-    e = (fac * fac * fac) * delta / (dd * dd)
-    y1 = 2.0 * sp * (p + lam) / d
+    rd = 1.0 / d
+    rdd = rd * sc
+    e = (fac * fac * fac) * delta * (rdd * rdd)
+    y1 = 2.0 * sp * (p + lam) * rd
     # the closed forms (atan, log1p: the costly part) only when an element needs them
     if closed is not True and closed:
         rc, ok = _rc1_halved(e, y1, closed, C)
@@ -595,13 +599,13 @@ def _rj_step(act, st, C: Consts, delta, sc, closed=True):
         0.25 * (y + lam),
         0.25 * (z + lam),
         0.25 * (p + lam),
-        acc + fac * rc / d,
+        acc + fac * rc * rd,
     )
     return tuple(jnp.where(act, nv, ov) for nv, ov in zip(new, st)), e
 
 
 def _rj_start(x, y, z, p, C: Consts):
-    a0 = (x + y + z + 2.0 * p) / 5.0
+    a0 = _rj_a0(x, y, z, p)
     delta, sc = _rj_delta(x, y, z, p, C)
     q = C.rj_q * jnp.maximum(
         jnp.maximum(jnp.abs(a0 - x), jnp.abs(a0 - y)),
@@ -613,26 +617,30 @@ def _rj_start(x, y, z, p, C: Consts):
 
 def _rj_end(x, y, z, a0, st):
     a, fac, _, _, _, _, acc = st
-    X = (a0 - x) * fac / a
-    Y = (a0 - y) * fac / a
-    Z = (a0 - z) * fac / a
-    Pp = -(X + Y + Z) / 2.0
+    sqa = jnp.sqrt(a)
+    ra = 1.0 / (a * sqa)
+    fa = fac * (ra * sqa)
+    X = (a0 - x) * fa
+    Y = (a0 - y) * fa
+    Z = (a0 - z) * fa
+    Pp = -0.5 * (X + Y + Z)
     xyz = X * Y * Z
     p2 = Pp * Pp
     e2 = X * Y + X * Z + Y * Z - 3.0 * p2
     e3 = xyz + 2.0 * e2 * Pp + 4.0 * p2 * Pp
     e4 = (2.0 * xyz + e2 * Pp + 3.0 * p2 * Pp) * Pp
     e5 = xyz * p2
+    # (constant coefficients: multiplications, not divisions)
     poly = (
         1.0
-        - 3.0 * e2 / 14.0
-        + e3 / 6.0
-        + 9.0 * e2 * e2 / 88.0
-        - 3.0 * e4 / 22.0
-        - 9.0 * e2 * e3 / 52.0
-        + 3.0 * e5 / 26.0
+        - (3.0 / 14.0) * e2
+        + (1.0 / 6.0) * e3
+        + (9.0 / 88.0) * (e2 * e2)
+        - (3.0 / 22.0) * e4
+        - (9.0 / 52.0) * (e2 * e3)
+        + (3.0 / 26.0) * e5
     )
-    return fac * poly / (a * jnp.sqrt(a)) + 6.0 * acc
+    return fac * poly * ra + 6.0 * acc
 
 
 def _rj_all(x, y, z, p, C: Consts, steps=None, converged=False):
@@ -658,7 +666,7 @@ def _rj_all(x, y, z, p, C: Consts, steps=None, converged=False):
 
 
 def _rj_a0(x, y, z, p):
-    return (x + y + z + 2.0 * p) / 5.0
+    return (x + y + z + 2.0 * p) * 0.2
 
 
 def _rj_short(x, y, z, p, C: Consts):

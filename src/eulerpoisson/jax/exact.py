@@ -59,14 +59,14 @@ __all__ = ["exact_motion"]
 
 def _qmin(M1, M2, M3, caseB, sa):
     """Quaternion of the minimal rotation taking ``M/|M|`` to ``e = sa e_a`` (components)."""
-    nrm = jnp.sqrt(M1 * M1 + M2 * M2 + M3 * M3)
-    x, y, z = M1 / nrm, M2 / nrm, M3 / nrm
+    rn = jax.lax.rsqrt(M1 * M1 + M2 * M2 + M3 * M3)
+    x, y, z = M1 * rn, M2 * rn, M3 * rn
     ze = jnp.where(caseB, sa * z, sa * x)
     vx = jnp.where(caseB, sa * y, 0.0)
     vy = jnp.where(caseB, -sa * x, sa * z)
     vz = jnp.where(caseB, 0.0, -sa * y)
     w = 1.0 + ze
-    f = 1.0 / jnp.sqrt(2.0 * w)
+    f = jax.lax.rsqrt(2.0 * w)
     return (w * f, vx * f, vy * f, vz * f)
 
 
@@ -291,9 +291,10 @@ def _jtot_args(nu, omnu, n, s, c, d, kp, sep):
     """
     odd = jnp.mod(n, 2.0) == 1.0
     sa_ = jnp.abs(s)
-    S = jnp.where(odd, c / d, sa_)
-    Cc = jnp.where(odd, kp * sa_ / d, c)
-    Dd = jnp.where(odd, kp / d, d)
+    rd = 1.0 / d
+    S = jnp.where(odd, c * rd, sa_)
+    Cc = jnp.where(odd, kp * sa_ * rd, c)
+    Dd = jnp.where(odd, kp * rd, d)
     S2 = S * S
     C2 = Cc * Cc
     p = jnp.where(nu <= 0.0, 1.0 - nu * S2, omnu + nu * C2)
@@ -309,7 +310,7 @@ def _jtot_end(rjv, ok, S, S2, odd, r, jc, n, sep, omnu):
     ``K``: a turning point of ``M``, e.g. an initial state with a zero component): there the
     derivative ``dJ/du = sn^2/(1 - nu sn^2) = 1/(1 - nu)`` is added explicitly (value unchanged).
     """
-    jq = jnp.where(ok, S * S2 * rjv / 3.0, 0.0)
+    jq = jnp.where(ok, S * S2 * rjv * (1.0 / 3.0), 0.0)
     jper = jnp.where(odd, jnp.sign(r) * (jc - jq), jnp.where(r < 0.0, -jq, jq))
     kink = odd & (r == 0.0)
     jper = jper + jnp.where(kink, (r - jax.lax.stop_gradient(r)) / jnp.where(kink, omnu, 1.0), 0.0)
@@ -364,9 +365,12 @@ def _generic(B: _Body, P: JacobiParams, ts, eq, eq_angle):
     zs = jnp.where(nzz, z, 1.0)
     nzw = w_s != 0.0
     ws = jnp.where(nzw, w_s, 1.0)
-    at = jnp.arctan2(jnp.where(B.sep, ws, zs), jnp.where(B.sep, v_s, 1.0))
-    xadd = -YX * jnp.where(nzz, at / zs, 1.0)
-    fsep = jnp.where(nzw, at / ws, 1.0 / jnp.where(B.sep, v_s, 1.0))
+    num = jnp.where(B.sep, ws, zs)
+    at = jnp.arctan2(num, jnp.where(B.sep, v_s, 1.0))
+    # (one quotient: at / zs off the separatrix, where xadd is used; at / ws on it, where fsep is)
+    aq = at / num
+    xadd = -YX * jnp.where(nzz, aq, 1.0)
+    fsep = jnp.where(nzw, aq, 1.0 / jnp.where(B.sep, v_s, 1.0))
     dlt = dh + dl
     use_sh = B.caseB & (jnp.abs(dlt) * B.g0 > B.Gc)
     # one R_J: the arguments of the near branch (J of delta, direct or shifted) or the far one
@@ -479,7 +483,7 @@ def _principal_motion(inertia, M0, t):
     Mg = _assemble((M1, M2, M3), shape)
     Mg = Mg * jnp.broadcast_to(scale_m, shape)[..., None]
     qg = _assemble(q, shape)
-    qg = qg / jnp.sqrt(jnp.sum(qg * qg, axis=-1, keepdims=True))
+    qg = qg * jax.lax.rsqrt(jnp.sum(qg * qg, axis=-1, keepdims=True))
     # t == 0: the initial condition exactly (with the derivative of the formula)
     at0 = (t == 0.0)[..., None]
     M0s = sgn * jnp.take_along_axis(M0, perm, axis=-1)

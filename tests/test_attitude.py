@@ -907,3 +907,21 @@ def test_as_scipy_raises_instead_of_flattening_on_old_scipy(monkeypatch):
     assert len(a.reshape(-1).as_scipy()) == 6
     with pytest.raises(ValueError, match="cannot reshape"):
         a.reshape(4)
+
+
+@pytest.mark.parametrize(("shape", "axis"), [((400, 4), 0), ((5, 300, 4), 1), ((300, 3, 4), 0), ((3, 5, 6, 4), -2)])
+def test_quaternion_make_continuous_flips_where_the_summed_dot_product_is_negative(shape, axis, rng):
+    # the reference: dot products by np.sum over the quaternion axis, a flip where one is negative, flips
+    # accumulated along the series; near-orthogonal neighbours (dot products decided by rounding) included
+    q = rng.standard_normal(shape)
+    q[..., 0] *= 1e-9
+    qm = np.moveaxis(q, axis, 0)
+    dots = np.sum(qm[1:] * qm[:-1], axis=-1)
+    flips = np.concatenate([np.zeros((1,) + dots.shape[1:], dtype=int), np.cumsum(dots < 0, axis=0)])
+    want = np.moveaxis(qm * np.where(flips % 2 == 1, -1.0, 1.0)[..., None], 0, axis)
+    got = at.quaternion_make_continuous(q, axis=axis)
+    assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
+    # a series without a flip comes back as a copy
+    pos = np.abs(q)
+    out = at.quaternion_make_continuous(pos, axis=axis)
+    assert np.array_equal(out, pos) and out is not pos and not np.shares_memory(out, pos)

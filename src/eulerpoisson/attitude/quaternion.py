@@ -245,9 +245,15 @@ def quaternion_make_continuous(q: ArrayLike, axis: int = 0) -> NDArray[np.float6
     qm = np.moveaxis(q, ax, 0)
     if qm.shape[0] < 2:
         return q.copy()
-    dots = np.sum(qm[1:] * qm[:-1], axis=-1)
-    flips = np.concatenate([np.zeros((1,) + dots.shape[1:], dtype=int), np.cumsum(dots < 0, axis=0)])
-    sign = np.where(flips % 2 == 1, -1.0, 1.0)
+    a, b = qm[1:], qm[:-1]
+    # the dot products summed in order, as np.sum over the last axis does (component arrays: several times faster)
+    dots = a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2] + a[..., 3] * b[..., 3]
+    flips = np.empty(qm.shape[:-1], dtype=np.int64)
+    flips[0] = 0
+    np.cumsum(dots < 0, axis=0, out=flips[1:])
+    if not flips[-1].any():
+        return q.copy()  # (the count is nondecreasing: no flip anywhere)
+    sign = 1.0 - 2.0 * (flips & 1)
     return np.moveaxis(qm * sign[..., None], 0, ax)
 
 

@@ -127,8 +127,16 @@ def xla_optimized():
     tell them apart: it is emptied before and after, so that no program compiled one way serves a test that
     runs the other way (later tests of the worker compile again, or read the persistent cache, whose key
     has the setting).
+
+    Not with XLA's older fusion emitter (:data:`_FAST_COMPILE_FLAG`, set above where jaxlib knows it): the
+    unoptimized programs then compile fast enough that they win (measured on 2 cores: the docstring examples
+    of eulerpoisson.jax.exact 25 s against 31 s, examples/jax_fit.py 66 s against 78 s), and the test keeps
+    the module's setting and its compiled programs.
     """
     jax = pytest.importorskip("jax", reason="jax is not installed: pip install 'eulerpoisson[jax]'")
+    if _FAST_COMPILE_FLAG in os.environ.get("XLA_FLAGS", ""):
+        yield
+        return
     previous = jax.config.values["jax_disable_most_optimizations"]
     jax.clear_caches()
     jax.config.update("jax_disable_most_optimizations", False)

@@ -235,32 +235,6 @@ def json_text(obj) -> str:
 MAX_MOMENTUM = math.sqrt(np.finfo(float).max)
 
 
-def _norms(a, axes: int | tuple[int, int] = -1) -> np.ndarray:
-    """Euclidean (Frobenius) norms over ``axes`` without overflow in the squares (inf only when the norm is)."""
-    a = np.abs(np.asarray(a, dtype=float))
-    top = np.max(a, axis=axes, keepdims=True)
-    safe = np.where(top > 0, top, 1.0)
-    return (
-        np.squeeze(safe, axis=axes) * np.sqrt(np.sum(np.square(a / safe), axis=axes)) * (np.squeeze(top, axis=axes) > 0)
-    )
-
-
-def _torque_bound(tq, inertia_max: float) -> float | None:
-    """An upper bound of |torque| over every attitude (None: unknown, e.g. a Python function)."""
-    try:
-        poly = tq.polynomial()
-    except Exception:  # noqa: BLE001 - a torque without a usable polynomial form: no bound
-        return None
-    if poly is None:
-        return None
-    with np.errstate(over="ignore", invalid="ignore"):
-        bound = float(np.max(_norms(poly.constant), initial=0.0))
-        for s, L in zip(poly.vectors, poly.maps):
-            bound += float(np.max(_norms(s) * _norms(L, (-2, -1)), initial=0.0))
-        bound += float(np.max(np.abs(np.asarray(poly.orbit_gain, dtype=float)), initial=0.0)) * inertia_max
-    return bound if not math.isnan(bound) else math.inf
-
-
 def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
     """Refuse a run whose numbers float64 cannot hold or follow, before it starts; the message names the flags.
 
@@ -293,6 +267,7 @@ def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
     the angular momentum |m| = |I omega| = 1.12e+308 of --inertia and --omega overflows float64 ...
     """
     from ..attitude.core import Attitude
+    from ..model.torque_base import scaled_norms, torque_bound
     from ..solvers.exact.method import MAX_PHASE
 
     body = model.body
@@ -307,9 +282,9 @@ def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
             M = np.einsum("...ji,...j->...i", R0, np.asarray(m0, dtype=float))
             w = np.einsum("...ij,...j->...i", np.asarray(body.inertia_inv, dtype=float), M)
             given = name("initial.m")
-        m_norm = float(np.max(_norms(M), initial=0.0))
+        m_norm = float(np.max(scaled_norms(M), initial=0.0))
         energy = float(np.max(0.5 * np.sum(w * M, axis=-1), initial=0.0))
-        w_norm = float(np.max(_norms(w), initial=0.0))
+        w_norm = float(np.max(scaled_norms(w), initial=0.0))
     if not (m_norm < MAX_MOMENTUM and math.isfinite(energy) and math.isfinite(w_norm)):
         raise UsageError(
             f"the angular momentum |m| = |I omega| = {m_norm:.3g} of {name('body.inertia')} and {given} overflows "
@@ -328,7 +303,7 @@ def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
         conservative, driven = 0.0, 0.0
         strongest, strongest_bound = None, -1.0
         for tq in model.torques:
-            bound = _torque_bound(tq, i_max)
+            bound = torque_bound(tq, i_max)
             if bound is None:
                 continue
             if bound > strongest_bound:

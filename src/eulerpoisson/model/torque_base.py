@@ -44,6 +44,9 @@ __all__ = [
     "z_rotation_quaternion",
     "STANDARD_GRAVITY",
     "SYMMETRY_RTOL",
+    "scaled_norms",
+    "torque_bound",
+    "check_torque_scales",
 ]
 
 #: standard gravity (m s-2), the default magnitude of :class:`Gravity`
@@ -79,6 +82,76 @@ def z_rotation_quaternion(phi: ArrayLike) -> NDArray[np.float64]:
     """
     phi = np.asarray(phi, dtype=float)
     return np.stack([np.cos(phi / 2), np.zeros_like(phi), np.zeros_like(phi), np.sin(phi / 2)], -1)
+
+
+def scaled_norms(a: ArrayLike, axes: int | tuple[int, int] = -1) -> NDArray[np.float64]:
+    """Euclidean (Frobenius) norms over ``axes`` without overflow in the squares (inf only when the norm is).
+
+    Examples
+    --------
+    >>> round(float(scaled_norms([3e200, 4e200, 0.0])) / 1e200, 12)
+    5.0
+    """
+    a = np.abs(np.asarray(a, dtype=float))
+    top = np.max(a, axis=axes, keepdims=True)
+    safe = np.where(top > 0, top, 1.0)
+    return (
+        np.squeeze(safe, axis=axes) * np.sqrt(np.sum(np.square(a / safe), axis=axes)) * (np.squeeze(top, axis=axes) > 0)
+    )
+
+
+def torque_bound(tq: Torque, inertia_max: float) -> float | None:
+    """An upper bound of ``|torque|`` over every attitude, from its polynomial form (None: unknown, e.g. a function).
+
+    ``inertia_max`` is the largest principal moment (an orbit term's gain scales with it). The bound is inf
+    where the torque's parameters overflow float64 together.
+
+    Examples
+    --------
+    >>> from eulerpoisson.torques import Gravity
+    >>> round(torque_bound(Gravity(2.0, [0.0, 0.0, 0.5], [0.0, 0.0, -10.0]), 1.0), 6)  # sqrt(2) |mu c| |g|
+    14.142136
+    >>> torque_bound(Gravity(1e300, [0.0, 0.0, 1e300]), 1.0)
+    inf
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        try:
+            poly = tq.polynomial()
+        except Exception:  # noqa: BLE001 - a torque without a usable polynomial form: no bound
+            return None
+    if poly is None:
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        bound = float(np.max(scaled_norms(poly.constant), initial=0.0))
+        for s, L in zip(poly.vectors, poly.maps):
+            bound += float(np.max(scaled_norms(s) * scaled_norms(L, (-2, -1)), initial=0.0))
+        bound += float(np.max(np.abs(np.asarray(poly.orbit_gain, dtype=float)), initial=0.0)) * inertia_max
+    return bound if not np.isnan(bound) else np.inf
+
+
+def check_torque_scales(torques: Sequence[Torque], inertia_max: float) -> None:
+    """Refuse torques whose parameters overflow float64 together (a torque that would be inf or NaN).
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the torque, when :func:`torque_bound` is inf.
+
+    Examples
+    --------
+    >>> from eulerpoisson.torques import Gravity
+    >>> check_torque_scales([Gravity(1e300, [0.0, 0.0, 1e300])], 1.0)
+    Traceback (most recent call last):
+    ...
+    eulerpoisson.errors.InvalidInputError: torque Gravity overflows float64: ...
+    """
+    for tq in torques:
+        bound = torque_bound(tq, inertia_max)
+        if bound is not None and not np.isfinite(bound):
+            raise InvalidInputError(
+                f"torque {type(tq).__name__} overflows float64: the product of its parameters is not a number "
+                f"(above {np.finfo(float).max:.2g}); write them in other units"
+            )
 
 
 def rotate_about_z(v: ArrayLike, phi: ArrayLike) -> NDArray[np.float64]:

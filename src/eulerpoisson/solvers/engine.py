@@ -63,6 +63,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidInputError
 from ..model.equations import Model
+from ..model.torque_base import check_torque_scales
 from ..trajectory import Trajectory
 from .parallel import check_workers, solve_batch
 from .problem import Problem, make_problem
@@ -596,6 +597,9 @@ def prepare_run(
     whole = isinstance(src, np.ndarray) and n <= SEGMENT
     t_first = read_times(src, 0, n if whole else min(n, SEGMENT))
     problem = make_problem(body, t_first, omega0=omega0, m0=m0, attitude0=attitude0, gibbs0=gibbs0, torque=torque)
+    if problem.model.torques:
+        # parameters that overflow together: an error here, not a NaN torque that each method reports its own way
+        check_torque_scales(problem.model.torques, float(np.max(problem.model.body.principal_moments)))
     if name is None:
         name = default_method(problem.model)
         cls = get_method(name)

@@ -673,6 +673,48 @@ def _per_time(c, tt):
     return cc, ss, cdot, sdot, rate_c, rate_s, perS, perD
 
 
+#: the largest phase ``W |t|`` at which float64 still determines the motion (the exact method's ``MAX_PHASE``)
+_MAX_PHASE = 2.0**48
+
+
+def _check_ranges(P: np.ndarray, A: np.ndarray, omega0: np.ndarray, t: np.ndarray) -> None:
+    """Refuse finite inputs whose gravity scale, frequency or phase leaves float64 (flattened bodies ``(Nb,)``).
+
+    Without this, an overflowing gravity scale ``P`` made the top free (a silent wrong answer) and an
+    overflowing frequency or phase gave NaN.
+    """
+    bad = ~np.isfinite(P)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError(
+            f"mass * |g| * |ell| overflows float64 (body {i} of the flattened batch): rescale the units "
+            "(the motion depends on mass * |g| * |ell| / A and omega0 only)"
+        )
+    with np.errstate(over="ignore", invalid="ignore"):
+        # |omega0|^2 scaled like |g| (no overflow of the squares for |omega0| below 1e308)
+        wmax = np.max(np.abs(omega0), axis=-1, initial=0.0)
+        ws = np.where(wmax > 0.0, wmax, 1.0)
+        w2 = wmax * wmax * np.sum((omega0 / ws[:, None]) ** 2, axis=-1)
+        W2 = P / A + w2
+        tmax = float(np.max(np.abs(t), initial=0.0))
+        phase = np.sqrt(W2) * tmax
+    bad = ~np.isfinite(W2)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError(
+            f"the squared frequency mass |g| |ell| / A + |omega0|^2 overflows float64 (body {i} of the flattened "
+            "batch): rescale the units of time"
+        )
+    bad = ~(phase <= _MAX_PHASE)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError(
+            f"W |t| = {phase[i]:.3g} (body {i} of the flattened batch, W the top's frequency "
+            f"sqrt(mass |g| |ell| / A + |omega0|^2), |t| = {tmax:.6g}) exceeds 2^48 = {_MAX_PHASE:.3g} rad: "
+            "float64 no longer determines the phase of the motion there"
+        )
+
+
 def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
     r"""Closed-form motion of a Lagrange top (heavy symmetric top).
 
@@ -716,7 +758,12 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
         (a ``ValueError``) naming the argument: ``A <= 0``, ``C <= 0``,
         ``C > 2 A``, ``mass < 0``, non-finite values, ``q0`` not of unit norm,
         wrong trailing dimensions, ``t`` not 1-D, shapes that do not
-        broadcast.
+        broadcast; finite values whose gravity scale
+        :math:`\mathrm{mass}\,|g|\,|\ell|` or squared frequency
+        :math:`W^2 = \mathrm{mass}\,|g|\,|\ell|/A + |\Omega_0|^2`
+        overflows float64, and times with :math:`W|t| > 2^{48}` (beyond
+        it float64 no longer determines the phase: the exact method's
+        limit).
 
     Notes
     -----
@@ -765,8 +812,16 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
     om_ = np.broadcast_to(omega0, shape + (3,)).reshape(Nb, 3)
     qn = q0_in / np.linalg.norm(q0_in, axis=-1, keepdims=True)
 
-    gn = np.linalg.norm(g_, axis=-1)
-    P = mass_ * gn * np.abs(ell_)
+    with np.errstate(over="ignore"):
+        gn = np.linalg.norm(g_, axis=-1)
+    if not np.all(np.isfinite(gn)):
+        # the plain norm overflows from |g| ~ 1e154 on: there scaled by the largest component
+        gmax = np.max(np.abs(g_), axis=-1, initial=0.0)
+        gs = np.where(gmax > 0.0, gmax, 1.0)
+        gn = np.where(np.isfinite(gn), gn, gmax * np.linalg.norm(g_ / gs[:, None], axis=-1))
+    with np.errstate(over="ignore"):
+        P = mass_ * gn * np.abs(ell_)
+    _check_ranges(P, A_, om_, t)
     # scales: frequency W ~ sqrt(P/A + |Omega0|^2) and inertia S ~ A, both
     # powers of two (the rescaling is exact); in the units t' = W t,
     # Omega' = Omega/W, A' = A/S, P' = P/(S W^2) the problem is O(1).  A gravity

@@ -95,6 +95,10 @@ class _StepBudgetExhausted(Exception):
     """Raised inside the right-hand side when ``max_steps`` is used up."""
 
 
+class _NonFiniteRate(Exception):
+    """Raised inside the right-hand side when it is not finite (its argument: the time)."""
+
+
 #: smallest relative tolerance scipy's solve_ivp honours (100 machine epsilons)
 _RTOL_MIN = 100 * np.finfo(float).eps
 
@@ -298,7 +302,11 @@ class RK(Method):
             count[0] += 1
             if count[0] > budget:
                 raise _StepBudgetExhausted
-            return f(t, y)
+            dy = f(t, y)
+            if not np.isfinite(dy).all():
+                # stop at once: the adaptive steps would shrink on NaN until max_steps, hours at the default
+                raise _NonFiniteRate(t)
+            return dy
 
         with np.errstate(over="ignore", invalid="ignore"):
             try:
@@ -312,6 +320,11 @@ class RK(Method):
                     dense_output=True,
                     events=events,
                 )
+            except _NonFiniteRate as exc:
+                raise EulerPoissonError(
+                    f"rk: the right-hand side is not finite at t = {exc.args[0]:.6g} (a torque or a rate that "
+                    "overflows float64, or a torque function that returned NaN); use smaller values"
+                ) from None
             except _StepBudgetExhausted:
                 raise EulerPoissonError(
                     f"rk: max_steps={max_steps} exhausted ({budget} evaluations of the right-hand side) before "

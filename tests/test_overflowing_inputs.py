@@ -1,0 +1,71 @@
+"""Finite inputs whose products leave float64: an error naming them, not a silent NaN or a different motion."""
+
+import numpy as np
+import pytest
+
+import eulerpoisson as ep
+from eulerpoisson.errors import EulerPoissonError, InvalidInputError
+from eulerpoisson.model.torque_base import check_torque_scales, scaled_norms, torque_bound
+from eulerpoisson.solvers.exact.lagrange import lagrange_top_motion
+
+T = np.linspace(0.0, 1.0, 3)
+TOP = {"A": 1.0, "C": 0.5, "mass": 1.0, "ell": 0.3, "g": [0.0, 0.0, -9.81], "q0": [1.0, 0, 0, 0], "w0": [0.1, 0, 20.0]}
+
+
+def _top(**change):
+    a = {**TOP, "t": T, **change}
+    return lagrange_top_motion(a["A"], a["C"], a["mass"], a["ell"], a["g"], a["q0"], a["w0"], a["t"])
+
+
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        # |g| beyond 1.3e154: its plain norm overflowed and the top silently became a free one
+        ({"g": [0.0, 0.0, -1e160]}, r"W \|t\| = 5\.48e\+79 .* exceeds 2\^48"),
+        ({"g": [0.0, 0.0, -1e300]}, r"exceeds 2\^48"),
+        ({"mass": 1e300, "g": [0.0, 0.0, -1e10]}, r"mass \* \|g\| \* \|ell\| overflows float64"),
+        ({"w0": [0.1, 0.0, 1e300]}, r"squared frequency .* overflows float64"),
+        ({"t": np.array([0.0, 1e300])}, r"\|t\| = 1e\+300\) exceeds 2\^48"),
+    ],
+)
+def test_lagrange_top_refuses_what_float64_cannot_follow(change, match):
+    with pytest.raises(InvalidInputError, match=match):
+        _top(**change)
+
+
+def test_lagrange_top_just_inside_the_range_is_unchanged():
+    """The checks leave an ordinary top's values as they were (bit for bit: the same code after them)."""
+    q, w = _top()
+    ref = ep.solve(
+        ep.RigidBody([1.0, 1.0, 0.5]), T, omega0=TOP["w0"], torque=ep.torques.Gravity(1.0, [0, 0, 0.3]), method="exact"
+    )
+    np.testing.assert_allclose(q, ref.quaternion, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(w, ref.omega, rtol=0, atol=1e-12)
+
+
+def test_torque_bound_and_scaled_norms():
+    np.testing.assert_allclose(scaled_norms([[3e200, 4e200, 0.0], [0.0, 0.0, 0.0]]), [5e200, 0.0], rtol=1e-15)
+    # |mu c x g| <= |[mu c]x|_F |g| = sqrt(2) |mu c| |g|: an upper bound
+    assert torque_bound(ep.torques.Gravity(2.0, [0.0, 0.0, 0.5], [0.0, 0.0, -10.0]), 1.0) == pytest.approx(10 * 2**0.5)
+    assert torque_bound(ep.torques.Gravity(1e300, [0.0, 0.0, 1e300]), 1.0) == np.inf
+    assert torque_bound(ep.torques.GravityGradient(1e200), 1.0) == np.inf
+    assert torque_bound(ep.torques.CallableTorque(lambda t, q, w: np.zeros(3)), 1.0) is None
+    check_torque_scales([ep.torques.Gravity(1.0, [0.0, 0.0, 0.1])], 2.0)  # a finite one passes
+
+
+@pytest.mark.parametrize("method", ["rk", "taylor", "exact", "symplectic", "rk4"])
+@pytest.mark.parametrize(
+    "torque, name",
+    [(ep.torques.Gravity(1e300, [0.0, 0.0, 1e300]), "Gravity"), (ep.torques.GravityGradient(1e200), "GravityGradient")],
+)
+def test_solve_refuses_a_torque_that_overflows(method, torque, name):
+    """Before: rk stepped on a NaN torque until max_steps (hours), taylor blamed "quaternion contains NaN"."""
+    with pytest.raises(InvalidInputError, match=rf"torque {name} overflows float64"):
+        ep.solve([1.0, 1.0, 0.5], [0.0, 1.0], omega0=[0.0, 0.2, 20.0], torque=torque, method=method)
+
+
+def test_rk_stops_at_the_first_non_finite_right_hand_side():
+    """A finite torque whose I^-1 tau overflows: rk stops at once instead of shrinking its steps for hours."""
+    big = ep.torques.CallableTorque(lambda t, q, w: np.full(np.shape(w), 1e308))
+    with pytest.raises(EulerPoissonError, match=r"rk: the right-hand side is not finite at t = 0"):
+        ep.solve([1.0, 1.0, 0.5], [0.0, 1.0], omega0=[0.0, 0.2, 2.0], torque=big, method="rk")

@@ -27,6 +27,7 @@ References
 from __future__ import annotations
 
 import functools
+import math
 from typing import NamedTuple
 
 import jax
@@ -49,7 +50,7 @@ from .elliptic import JacobiParams, consts, fused_loops, jacobi_params, rf, rj, 
 from .precision import as_float, float64_by_default
 from .quaternion import qmul_components as _qmul
 
-__all__ = ["exact_motion"]
+__all__ = ["exact_motion", "check_inputs", "check_phase", "normalized", "MAX_PHASE"]
 
 
 # ---------------------------------------------------------------------------
@@ -559,15 +560,92 @@ def _is_tracer(x) -> bool:
     return isinstance(x, jax.core.Tracer)
 
 
-def _check_inputs(inertia, q0, omega0, t, tensor: bool) -> None:
-    """Value checks on concrete inputs (under tracing only the shapes are checked)."""
+#: the largest :math:`|\Omega_0||t|` the closed form accepts (``ep.solve(..., method="exact")``'s limit: beyond
+#: it the rounding of the frequencies shifts the phase of the motion by more than 0.1 rad)
+MAX_PHASE = 2.0**48
+
+
+def normalized(q):
+    """``q / |q|`` along the last axis, computed after an exact power-of-two scaling of each quaternion (its
+    largest component in [0.5, 1)): no overflow or underflow of ``|q|^2`` for huge or tiny quaternions, and
+    the same bits as the unscaled quotient where that one neither overflows nor underflows.
+
+    Examples
+    --------
+    >>> import jax, numpy as np
+    >>> from eulerpoisson.jax.exact import normalized
+    >>> with jax.enable_x64(True):
+    ...     print(np.asarray(normalized(np.array([1e300, 1e300, 0.0, 0.0]))))
+    [0.70710678 0.70710678 0.         0.        ]
+    """
+    q = jnp.asarray(q)
+    big = jax.lax.stop_gradient(jnp.max(jnp.abs(q), axis=-1, keepdims=True))
+    e = jnp.where(big > 0.0, jnp.frexp(big)[1], 0)
+    q = q * exp2i(-e, q.dtype)
+    return q / jnp.sqrt(jnp.sum(q * q, axis=-1, keepdims=True))
+
+
+def _not_finite(name: str, x, raw) -> InvalidInputError | None:
+    """The error for a non-finite concrete ``x`` (``raw``: the input before its cast to the computing dtype)."""
+    if np.all(np.isfinite(np.asarray(x))):
+        return None
+    if raw is not None and np.asarray(x).dtype == np.float32 and not _is_tracer(raw):
+        try:
+            r = np.asarray(raw, dtype=np.float64)
+        except (TypeError, ValueError):
+            r = None
+        if r is not None and np.all(np.isfinite(r)):
+            return InvalidInputError(
+                f"{name} overflows float32 (dtype=jnp.float32): its largest |value| {float(np.max(np.abs(r))):.3g} "
+                f"exceeds {float(np.finfo(np.float32).max):.3g}; rescale the problem or compute in float64"
+            )
+    return InvalidInputError(f"{name} must be finite, got non-finite values (shape {np.shape(x)})")
+
+
+def check_inputs(inertia, quaternion0, omega0, times, *, tensor: bool, raw=None) -> None:
+    """The value checks of :func:`exact_motion` (and :func:`eulerpoisson.jax.integrate`) on concrete inputs.
+
+    A traced input (under ``jit``, ``vmap`` or ``grad``) is not checked: its values are unknown.
+
+    Parameters
+    ----------
+    inertia, quaternion0, omega0 : arrays
+        As given to :func:`exact_motion`, cast to the computing dtype (``inertia`` a tensor when ``tensor``).
+    times : sequence of (str, array)
+        The time arguments and their names (``t``; ``t_end`` and ``t0``).
+    tensor : bool
+        Whether ``inertia`` is a (..., 3, 3) tensor.
+    raw : mapping of str to array_like, optional
+        The inputs before the cast, by name: a finite value that overflows float32 on the cast is then
+        reported as such.
+
+    Raises
+    ------
+    InvalidInertiaError
+        ``inertia`` non-finite, not symmetric or not positive definite.
+    InvalidInputError
+        Non-finite ``quaternion0``, ``omega0`` or times, a zero (or subnormal) ``quaternion0``, an ``omega0`` whose square
+        overflows, or an angular momentum ``inertia @ omega0`` that overflows the computing dtype.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.jax.exact import check_inputs
+    >>> check_inputs(np.ones(3), np.array([1.0, 0, 0, 0]), np.array([0.0, 0, 1]), [("t", np.zeros(2))], tensor=False)
+    >>> check_inputs(np.ones(3), np.zeros(4), np.array([0.0, 0, 1]), [("t", np.zeros(2))], tensor=False)
+    Traceback (most recent call last):
+    ...
+    eulerpoisson.errors.InvalidInputError: quaternion0 must be a non-zero quaternion (w, x, y, z), got a zero one
+    """
+    raw = raw or {}
     if not _is_tracer(inertia):
         I = np.asarray(inertia)
-        if not np.all(np.isfinite(I)):
-            raise InvalidInertiaError(f"inertia must be finite, got non-finite values (shape {I.shape})")
+        err = _not_finite("inertia", I, raw.get("inertia"))
+        if err is not None:
+            raise InvalidInertiaError(str(err))
         if tensor:
             scale = np.max(np.abs(I), axis=(-1, -2), keepdims=True)
-            asym = np.max(np.abs(I - np.swapaxes(I, -1, -2)) / np.where(scale > 0, scale, 1.0))
+            asym = np.max(np.abs(I - np.swapaxes(I, -1, -2)) / np.where(scale > 0, scale, 1.0), initial=0.0)
             if asym > 1e-12 * (1e5 if I.dtype == np.float32 else 1.0):
                 raise InvalidInertiaError(
                     f"inertia (a tensor of shape {I.shape}) is not symmetric: max |I - I^T| / max |I| = {asym:.3g}"
@@ -581,13 +659,86 @@ def _check_inputs(inertia, q0, omega0, t, tensor: bool) -> None:
             raise InvalidInertiaError(
                 f"inertia must be positive definite: {what} {bad.tolist()}, every one must be > 0"
             )
-    for name, x in (("quaternion0", q0), ("omega0", omega0), ("t", t)):
-        if not _is_tracer(x) and not np.all(np.isfinite(np.asarray(x))):
-            raise InvalidInputError(f"{name} must be finite, got non-finite values (shape {np.shape(x)})")
-    if not _is_tracer(q0):
-        norm = np.linalg.norm(np.asarray(q0), axis=-1)
-        if np.any(norm == 0.0):
+    for name, x in (("quaternion0", quaternion0), ("omega0", omega0), *times):
+        if not _is_tracer(x):
+            err = _not_finite(name, x, raw.get(name))
+            if err is not None:
+                raise err
+    if not _is_tracer(quaternion0):
+        q = np.asarray(quaternion0)
+        if np.any(np.all(q == 0.0, axis=-1)):
             raise InvalidInputError("quaternion0 must be a non-zero quaternion (w, x, y, z), got a zero one")
+        if np.any(np.all(np.abs(q) < np.finfo(q.dtype).tiny, axis=-1)):
+            raise InvalidInputError(
+                "quaternion0 must be a non-zero quaternion (w, x, y, z), got a subnormal one (XLA flushes subnormal "
+                "numbers to zero); scale it up"
+            )
+    if not _is_tracer(omega0):
+        w = np.asarray(omega0)
+        big = float(np.sqrt(np.finfo(w.dtype).max)) / 4.0
+        speed = float(np.max(_speed(w), initial=0.0))
+        if speed > big:
+            raise InvalidInputError(
+                f"omega0 is too large: |omega0| = {speed:.3g} exceeds {big:.3g} (its square must stay finite in "
+                f"{w.dtype}); rescale the problem (time unit)"
+            )
+        if not _is_tracer(inertia):
+            I = np.asarray(inertia)
+            imax = np.max(np.abs(I), axis=(-1, -2) if tensor else -1)
+            with np.errstate(over="ignore"):
+                mom = float(np.max(3.0 * imax * _speed(w) if imax.size and w.size else 0.0, initial=0.0))
+            if not mom <= float(np.finfo(w.dtype).max):
+                raise InvalidInputError(
+                    f"the angular momentum inertia @ omega0 overflows {w.dtype} (|I| |omega0| up to {mom / 3.0:.3g}); "
+                    "rescale the problem (units)"
+                )
+
+
+def _speed(w):
+    """``|w|`` along the last axis (NumPy, concrete), without overflow of the squares."""
+    w = np.abs(np.asarray(w, dtype=np.float64))
+    big = np.max(w, axis=-1, initial=0.0)
+    safe = np.where(big > 0.0, big, 1.0)
+    return big * np.sqrt(np.sum((w / safe[..., None]) ** 2, axis=-1))
+
+
+def check_phase(omega0, t, what: str = "t", factor: float = 1.0) -> None:
+    r"""Refuse :math:`|\Omega_0|\,|t|` beyond ``2^48`` (:data:`MAX_PHASE`), as ``ep.solve(..., method="exact")``.
+
+    ``omega0`` (..., 3) and ``t`` broadcast elementwise (batch shapes); ``factor`` multiplies ``|t|`` (the
+    largest fraction of a step a composition flows over). Concrete values only: nothing is checked when
+    either is traced.
+
+    Raises
+    ------
+    InvalidInputError
+        When some :math:`|\Omega_0|\,|t|` exceeds ``2^48`` (or overflows).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from eulerpoisson.jax.exact import check_phase
+    >>> check_phase(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0e3]))
+    >>> check_phase(np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0e15]))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    eulerpoisson.errors.InvalidInputError: |omega0| |t| = 1e+15 exceeds 2^48 = 2.81e+14 rad: ...
+    """
+    if _is_tracer(omega0) or _is_tracer(t):
+        return
+    speed = _speed(omega0)
+    tt = np.abs(np.asarray(t, dtype=np.float64)) * factor
+    if speed.size == 0 or tt.size == 0:
+        return
+    with np.errstate(over="ignore", invalid="ignore"):
+        phase = np.where(speed == 0.0, 0.0, np.broadcast_to(speed, np.broadcast_shapes(speed.shape, tt.shape)) * tt)
+    worst = float(np.max(phase))
+    if not worst <= MAX_PHASE:
+        raise InvalidInputError(
+            f"|omega0| |{what}| = {worst:.3g} exceeds 2^48 = {MAX_PHASE:.3g} rad: the rounding of the frequencies "
+            "(a few ulp) already shifts the phase of the motion by more than 0.1 rad, so float64 cannot say where "
+            "on its orbit the body is; use shorter times"
+        )
 
 
 @float64_by_default
@@ -618,11 +769,12 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
         allowed) or a symmetric positive-definite inertia tensor in the body frame. An array whose
         last two axes are (3, 3) is a tensor.
     quaternion0 : array_like, shape (..., 4)
-        Attitude at ``t = 0``, scalar first (normalized here).
+        Attitude at ``t = 0``, scalar first (normalized here, after an exact scaling: any finite
+        non-zero magnitude).
     omega0 : array_like, shape (..., 3)
         Body angular velocity at ``t = 0``.
     t : array_like, any shape
-        Times (any sign). ``t`` has no component axis: the batch shapes of the three other inputs
+        Times (any sign; empty: empty results). ``t`` has no component axis: the batch shapes of the three other inputs
         and the shape of ``t`` broadcast elementwise (one body at many times: ``t`` of shape
         ``(T,)``; bodies ``(N, 1, 3)`` at times ``(T,)``: results ``(N, T, ...)``).
     dtype : None, jnp.float64 or jnp.float32
@@ -639,14 +791,24 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
     ------
     InvalidInputError
         Wrong shapes (the last axis of ``quaternion0`` not 4, of ``omega0`` not 3), batch shapes
-        that do not broadcast, non-finite ``quaternion0``, ``omega0`` or ``t``, a zero
-        ``quaternion0``.
+        that do not broadcast, non-numeric input; with concrete values also non-finite
+        ``quaternion0``, ``omega0`` or ``t`` (or, with ``dtype=jnp.float32``, finite values that
+        overflow float32), a zero ``quaternion0``, an ``omega0`` whose square or angular momentum
+        overflows, or :math:`|\Omega_0|\,|t| > 2^{48}` (as ``ep.solve(..., method="exact")``:
+        float64 no longer determines the phase of the motion).
     InvalidInertiaError
-        ``inertia`` not of shape (..., 3) or (..., 3, 3), non-finite, not symmetric or not
-        positive definite (a moment ``<= 0``). Values are checked when the inputs are concrete;
-        under ``jit``/``grad``/``vmap`` tracing only the shapes are.
+        ``inertia`` not of shape (..., 3) or (..., 3, 3); with concrete values also non-finite,
+        not symmetric or not positive definite (a moment ``<= 0``). The triangle inequalities
+        :math:`I_i + I_j \ge I_k` of a physical body are not required (as
+        ``ep.solve(..., allow_unphysical=True)``).
     PrecisionError
         When traced with 64-bit floats off and ``dtype`` not float32.
+
+    Values are checked only when the inputs are concrete (an eager call). Under ``jit``, ``vmap``
+    or ``grad`` (traced inputs) only the shapes are checked: a NaN or infinite input, a zero
+    ``quaternion0``, an inertia that is not positive definite or a phase beyond :math:`2^{48}`
+    then gives NaN (or meaningless) outputs without an error. Check the inputs before tracing
+    (or call eagerly once) when they may be invalid.
 
     Notes
     -----
@@ -706,6 +868,7 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
     >>> dw.shape
     (3, 3)
     """
+    raw = {"inertia": inertia, "quaternion0": quaternion0, "omega0": omega0, "t": t}
     inertia = as_float(inertia, dtype, "inertia")
     q0 = as_float(quaternion0, dtype, "quaternion0")
     w0 = as_float(omega0, dtype, "omega0")
@@ -727,7 +890,10 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
             f"the batch shapes of inertia {bI}, quaternion0 {q0.shape[:-1]}, omega0 {w0.shape[:-1]} and the shape "
             f"of t {t.shape} do not broadcast"
         ) from exc
-    _check_inputs(inertia, q0, w0, t, tensor)
+    check_inputs(inertia, q0, w0, [("t", t)], tensor=tensor, raw=raw)
+    check_phase(w0, t)
+    if math.prod(shape) == 0:  # nothing to compute (an empty t or batch)
+        return jnp.zeros(tuple(shape) + (4,), dtype), jnp.zeros(tuple(shape) + (3,), dtype)
     return _motion(inertia, q0, w0, t, tensor=tensor, shape=tuple(shape))
 
 
@@ -735,7 +901,7 @@ def exact_motion(inertia, quaternion0, omega0, t, *, dtype=None):
 def _motion(inertia, q0, w0, t, *, tensor, shape):
     """The computation of :func:`exact_motion` after the checks, compiled once per shape and dtype (an eager
     call then costs one dispatch, not one per operation; inside a user's ``jit`` it is inlined)."""
-    q0 = q0 / jnp.sqrt(jnp.sum(q0 * q0, axis=-1, keepdims=True))
+    q0 = normalized(q0)
     if tensor:
         A = 0.5 * (inertia + jnp.swapaxes(inertia, -1, -2))
         ev, P = _eigh(A)

@@ -460,6 +460,11 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, dtype=None):
     PrecisionError
         Traced in float64 with 64-bit floats off.
 
+    Values are checked only when the inputs are concrete (an eager call). Under ``jit``, ``vmap``
+    or ``grad`` (traced inputs) only the shapes are checked: a NaN or infinite input, a zero or
+    non-unit ``q0``, ``A <= 0``, ``C <= 0``, ``C > 2 A`` or ``mass < 0`` then gives NaN (or
+    meaningless) outputs without an error.
+
     Examples
     --------
     >>> import numpy as np

@@ -53,8 +53,10 @@ from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ..errors import InvalidInputError
+from .exact import check_inputs, check_phase, normalized
 from .precision import as_float, float64_by_default
 from .quaternion import qconj as _conj
 from .quaternion import qmul as _qmul
@@ -257,10 +259,11 @@ def integrate(
     Parameters
     ----------
     inertia : array_like, shape (..., 3) or (..., 3, 3)
-        Principal moments (the body frame is the principal frame) or the inertia tensor (body frame,
-        diagonalized once).
+        Principal moments (the body frame is the principal frame) or the symmetric positive-definite
+        inertia tensor (body frame, diagonalized once).
     quaternion0 : array_like, shape (..., 4)
-        Initial attitudes, scalar first, body to space (normalized here).
+        Initial attitudes, scalar first, body to space (normalized here, after an exact scaling:
+        any finite non-zero magnitude).
     omega0 : array_like, shape (..., 3)
         Initial body angular velocities.
     t_end : float or array_like, shape (...)
@@ -290,13 +293,26 @@ def integrate(
     Raises
     ------
     InvalidInputError
-        Wrong shapes, non-numeric input, ``n_steps`` or ``save_every`` not a positive int (or
-        ``save_every`` not dividing ``n_steps``), an order other than 2 or 4, or a torque that is not
-        a torque.
+        Wrong shapes, batch shapes that do not broadcast, non-numeric input, ``n_steps`` or
+        ``save_every`` not a positive int (or ``save_every`` not dividing ``n_steps``), an order other
+        than 2 or 4, or a torque that is not a torque; with concrete values also non-finite
+        ``quaternion0``, ``omega0``, ``t_end`` or ``t0`` (or, with ``dtype=jnp.float32``, finite values
+        that overflow float32), a zero ``quaternion0``, an ``omega0`` whose square or angular momentum
+        overflows, ``t_end - t0`` that overflows, or :math:`|\Omega_0|\,|h| > 2^{48}` for a flow of
+        the first step (:func:`eulerpoisson.jax.exact.check_phase`).
+    InvalidInertiaError
+        With concrete values: ``inertia`` non-finite, not symmetric or not positive definite (the
+        checks of :func:`~eulerpoisson.jax.exact.exact_motion`; the triangle inequalities are not
+        required).
     UnsupportedModelError
         A torque of :mod:`eulerpoisson.torques` without a JAX twin (a NumPy function).
     PrecisionError
         Traced in float64 with 64-bit floats off.
+
+    Values are checked only when the inputs are concrete (an eager call). Under ``jit``, ``vmap``
+    or ``grad`` (traced inputs) only the shapes are checked: a NaN or infinite input, a zero
+    ``quaternion0`` or an inertia that is not positive definite then gives NaN outputs without an
+    error. The torque's parameters are not checked here.
 
     Notes
     -----
@@ -339,6 +355,26 @@ def integrate(
         raise InvalidInputError(f"quaternion0 must have shape (..., 4), got {q0.shape}")
     if w0.ndim == 0 or w0.shape[-1] != 3:
         raise InvalidInputError(f"omega0 must have shape (..., 3), got {w0.shape}")
+    bI = I.shape[:-2] if tensor else I.shape[:-1]
+    try:
+        jnp.broadcast_shapes(bI, q0.shape[:-1], w0.shape[:-1], te.shape, ts.shape)
+    except ValueError as exc:
+        raise InvalidInputError(
+            f"the batch shapes of inertia {bI}, quaternion0 {q0.shape[:-1]}, omega0 {w0.shape[:-1]}, t_end "
+            f"{te.shape} and t0 {ts.shape} do not broadcast"
+        ) from exc
+    raw = {"inertia": inertia, "quaternion0": quaternion0, "omega0": omega0, "t_end": t_end, "t0": t0}
+    check_inputs(I, q0, w0, [("t_end", te), ("t0", ts)], tensor=tensor, raw=raw)
+    if not isinstance(te, jax.core.Tracer) and not isinstance(ts, jax.core.Tracer):
+        with np.errstate(over="ignore", invalid="ignore"):
+            span = np.asarray(te, np.float64) - np.asarray(ts, np.float64)
+            fits = np.all(np.isfinite(span)) and np.all(np.isfinite(np.asarray(span, dt)))
+        if not fits:
+            raise InvalidInputError(f"t_end - t0 overflows {np.dtype(dt)}; use a shorter time span")
+        try:
+            check_phase(w0, span / n_steps, "h", max(abs(x) for x in composition(order)[1]))
+        except InvalidInputError as exc:
+            raise InvalidInputError(f"the free flow over a step h = (t_end - t0) / n_steps: {exc}") from None
     return _run(I, q0, w0, te, ts, tq, n_steps=n_steps, order=order, save_every=save_every, flow=flow, dtype=dt)
 
 
@@ -348,7 +384,7 @@ def _run(I, q0, w0, te, ts, tq, *, n_steps, order, save_every, flow, dtype):
     dt = dtype
     c, d = composition(order)
     tensor = I.ndim >= 2 and I.shape[-2:] == (3, 3)
-    q0 = _normalize(q0)
+    q0 = normalized(q0)
     if tensor:
         D, P = jnp.linalg.eigh(I)
         sign = jnp.sign(jnp.linalg.det(P))

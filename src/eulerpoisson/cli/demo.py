@@ -21,13 +21,23 @@ while it nutates, with a cusp each time the axis stops at its highest point.
 It is solved with the Taylor integrator and, when the closed form supports
 the Lagrange top, with ``method="exact"`` too (the largest difference is
 printed); the locus of the axis on the unit sphere is drawn (``top_apex.png``).
+
+The outputs follow the policy of every command (:mod:`eulerpoisson.io.outputs`):
+the folder is created when missing, and a file already in it is replaced only
+when it holds what the demo writes there (:data:`DEMO_FILES`: a NetCDF file, a
+picture, an animation page, a fit result or an audit report of ours, recognized
+by content), so that ``make demo`` reruns into the same folder; any other file
+(a configuration, data, notes) is never replaced: the demo stops before any work.
+The demo has no ``--overwrite``: it always replaces its own outputs.
 """
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import os
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +47,27 @@ from ..analysis import flip_times, tennis_racket_half_period
 from ..model.body import RigidBody
 from ..solvers import solve
 
-__all__ = ["run_demo", "run_top", "run_fit", "TENNIS_RACKET", "HEAVY_TOP", "TUMBLER"]
+__all__ = ["run_demo", "run_top", "run_fit", "TENNIS_RACKET", "HEAVY_TOP", "TUMBLER", "DEMO_FILES"]
+
+#: every file the demo writes into its folder, and its kind (:data:`eulerpoisson.io.outputs.KINDS`): a file
+#: already there is replaced only when it holds this kind of output (:func:`eulerpoisson.io.outputs.check_output`)
+DEMO_FILES: dict[str, str] = {
+    "tennis_racket.nc": "netcdf",
+    "omega.png": "figure",
+    "polhode.png": "figure",
+    "gibbs.png": "figure",
+    "invariants.png": "figure",
+    "attitude.png": "figure",
+    "tennis_racket.html": "movie",
+    "top.nc": "netcdf",
+    "top_apex.png": "figure",
+    "fit.json": "fit-result",
+    "fit_residuals.png": "figure",
+    "audit.md": "audit-report",
+    "audit.json": "audit-report",
+}
+_TOP_FILES = ("top.nc", "top_apex.png")
+_FIT_FILES = ("fit.json", "fit_residuals.png")
 
 #: the demo's body and initial body angular momentum
 TENNIS_RACKET: dict[str, Any] = {"inertia": (3.0, 5.0, 8.0), "M0": (0.0, 2.0, 0.01)}
@@ -68,13 +98,74 @@ TUMBLER: dict[str, Any] = {
 }
 
 
+def _make_folder(out: Path) -> None:
+    """Create the output folder ``out``; an :class:`OutputError` when it, or a folder above it, is a file."""
+    from ..errors import OutputError
+    from ..io.atomic import write_error
+
+    for p in (out, *out.parents):
+        if p.exists() or p.is_symlink():
+            if not p.is_dir():
+                where = "" if p == out else f": {p} is a file"
+                what = "is a file, not a folder" if p == out else "is under a file, not in a folder"
+                raise OutputError(
+                    f"--out {os.fspath(out)!r} {what}{where}; the demo writes a folder of files: "
+                    "give a new or existing folder"
+                )
+            break
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise write_error(out, exc) from None
+
+
+@contextlib.contextmanager
+def _claim_folder(out: Path, names: Iterable[str]) -> Iterator[None]:
+    """Claim the files ``names`` of folder ``out`` for the whole work (the policy of :func:`claim_output`).
+
+    Each is checked before any work (only an output of its kind of
+    :data:`DEMO_FILES` is replaced), the folder is created and locked (a
+    second demo writing there fails at once), and each file is checked again
+    just before its rename.
+    """
+    from ..io.atomic import guard_replace
+    from ..io.outputs import OutputLock, check_output
+
+    checks = [
+        (out / name, functools.partial(check_output, out / name, DEMO_FILES[name], overwrite=True, flag="the demo"))
+        for name in names
+    ]
+    _make_folder(out)
+    for _, check in checks:
+        check()
+    with contextlib.ExitStack() as claims:
+        claims.enter_context(OutputLock(out / "demo"))  # .demo.lock in the folder
+        for path, check in checks:
+            check()
+            claims.enter_context(guard_replace(path, check))
+        yield
+
+
 def run_fit(out: str | os.PathLike[str], *, say: Callable[[str], object] = print) -> list[Path]:
-    """The fit scene: synthetic noisy observations of a tumbling body, fitted; ``fit.json`` and a residual plot."""
+    """The fit scene: synthetic noisy observations of a tumbling body, fitted; ``fit.json`` and a residual plot.
+
+    Raises
+    ------
+    OutputError
+        ``out`` is a file, or a file of another kind is where an output goes (nothing is written).
+    """
+    out = Path(out)
+    with _claim_folder(out, _FIT_FILES):
+        return _fit_scene(out, say)
+
+
+def _fit_scene(out: Path, say: Callable[[str], object]) -> list[Path]:
     from ..estimation import fit
     from ..estimation.residuals import exp_quaternion
+    from ..io.atomic import atomic_write_text
+    from ..io.outputs import mark_text
     from ..numerics.quaternion import qmul
 
-    out = Path(out)
     body = RigidBody(TUMBLER["moments"], name="tumbler")
     q0 = np.array(TUMBLER["attitude0"]) / np.linalg.norm(TUMBLER["attitude0"])
     t = np.linspace(0.0, TUMBLER["t_end"], TUMBLER["samples"])
@@ -88,7 +179,7 @@ def run_fit(out: str | os.PathLike[str], *, say: Callable[[str], object] = print
     res = fit(t, attitude=q_obs, attitude_sigma=sa, omega=w_obs, omega_sigma=sw)
     wall = time.perf_counter() - t0
     js = out / "fit.json"
-    res.to_json(js)
+    atomic_write_text(js, mark_text(res.to_json(), "fit-result", "json"))  # marked: recognized as ours on a rerun
     files = [js]
     try:
         fig = res.plot_residuals()
@@ -143,12 +234,22 @@ def run_top(
     Solved with ``method="taylor"``; also with ``method="exact"`` when the
     closed form runs the Lagrange top (an :class:`UnsupportedModelError`
     otherwise, which skips the comparison).
+
+    Raises
+    ------
+    OutputError
+        ``out`` is a file, or a file of another kind is where an output goes (nothing is written).
     """
+    out = Path(out)
+    with _claim_folder(out, _TOP_FILES):
+        return _top_scene(out, say, t_end, samples)
+
+
+def _top_scene(out: Path, say: Callable[[str], object], t_end: float, samples: int) -> list[Path]:
     from ..errors import UnsupportedModelError
     from ..model.torques import Gravity
     from ..viz import plots
 
-    out = Path(out)
     body = RigidBody(HEAVY_TOP["inertia"], name="heavy top")
     top = Gravity(HEAVY_TOP["mass"], HEAVY_TOP["center_of_mass"], HEAVY_TOP["g"])
     half = np.radians(HEAVY_TOP["tilt_deg"]) / 2
@@ -203,7 +304,7 @@ def run_demo(
     Parameters
     ----------
     out : str or Path
-        Output folder (created).
+        Output folder (created; an existing one is written into).
     quiet : bool
         Print nothing.
     t_end, samples : float, int
@@ -213,9 +314,20 @@ def run_demo(
     -------
     int
         Exit status 0.
+
+    Raises
+    ------
+    OutputError
+        ``out`` is a file (or is under one), or a file in it named as an
+        output holds something else than the demo writes there
+        (:data:`DEMO_FILES`): checked before any work, nothing is written.
     """
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    with _claim_folder(out, DEMO_FILES):
+        return _demo(out, quiet, t_end, samples)
+
+
+def _demo(out: Path, quiet: bool, t_end: float, samples: int) -> int:
     say = (lambda *a: None) if quiet else print
     t0 = time.perf_counter()
     body = RigidBody(TENNIS_RACKET["inertia"], name="tennis racket")
@@ -238,6 +350,8 @@ def run_demo(
         path = out / f"{kind}.png"
         plots.plot(traj, kind, out=path)
         files.append(path)
+    from ..io.atomic import atomic_path, atomic_write_text
+    from ..io.outputs import mark_text
     from ..viz.animate import animate
 
     anim = out / "tennis_racket.html"
@@ -245,18 +359,22 @@ def run_demo(
     from ..trajectory import Trajectory
 
     light = Trajectory(traj.t[sub], traj.quaternion[sub], traj.omega[sub], body, traj.method, traj.options)
-    animate(light, anim)
+    with atomic_path(anim, suffix=".html") as tmp:  # the page, marked (recognized as ours on a rerun), then renamed
+        animate(light, tmp)
+        page = Path(tmp).read_text(encoding="utf-8")
+        Path(tmp).write_text(mark_text(page, "animation", "html"), encoding="utf-8")
     files.append(anim)
     top_lines: list[str] = []
-    files.extend(run_top(out, say=top_lines.append))
+    files.extend(_top_scene(out, top_lines.append, HEAVY_TOP["t_end"], HEAVY_TOP["samples"]))
     fit_lines: list[str] = []
-    files.extend(run_fit(out, say=fit_lines.append))
-    from ..paper.audit import run_audit, write_report
+    files.extend(_fit_scene(out, fit_lines.append))
+    from ..paper.audit import run_audit
 
     report = run_audit()
     for fmt in ("md", "json"):
         path = out / f"audit.{fmt}"
-        write_report(report, fmt, path)
+        text = {"md": report.to_markdown, "json": report.to_json}[fmt]()
+        atomic_write_text(path, mark_text(text, "audit-report", fmt))  # marked as ``eulerpoisson audit`` does
         files.append(path)
 
     wall = time.perf_counter() - t0

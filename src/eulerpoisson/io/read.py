@@ -38,9 +38,11 @@ variables asked for are read; equally spaced times are computed, not read.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import threading
+import zlib
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -140,7 +142,53 @@ def _time_grid(attrs, T: int, first: float, last: float):
 # reading chunks without zarr's machinery (the layout we write)
 # ---------------------------------------------------------------------------
 class _NotDirect(Exception):
-    """The direct reader cannot read this chunk (zarr reads it instead)."""
+    """The direct reader cannot read this chunk (zarr reads it instead).
+
+    ``chunk`` names the chunk (``"omega/c/0/0"``) when its bytes could not be decoded.
+    """
+
+    def __init__(self, message: str, chunk: str | None = None) -> None:
+        super().__init__(message)
+        self.chunk = chunk
+
+
+def _is_codec_error(exc: BaseException) -> bool:
+    """Whether ``exc`` says that a stored chunk cannot be decoded (its bytes are not what the codecs wrote).
+
+    Only these: numcodecs' ``RuntimeError`` ("Zstd decompression error ...",
+    "error during blosc decompression ..."), zlib's error (gzip), and the
+    ``ValueError`` of a chunk that decodes to the wrong number of values
+    ("cannot reshape array of size 3 into shape (5,3)").
+    """
+    if isinstance(exc, zlib.error):
+        return True
+    text = str(exc).lower()
+    if isinstance(exc, RuntimeError):
+        return "decompress" in text or "zstd" in text or "blosc" in text or "lz4" in text
+    if isinstance(exc, ValueError):
+        return text.startswith("cannot reshape array")
+    return False
+
+
+@contextlib.contextmanager
+def _decoding(store: Any, name: str, chunk: str | None = None) -> Iterator[None]:
+    """Re-raise a codec error (:func:`_is_codec_error`) met while reading variable ``name`` as an input error.
+
+    Raises
+    ------
+    EulerPoissonError
+        ``"{store} is not a readable Zarr store: chunk {chunk} is corrupt (...)"`` (or "a chunk of {name}"
+        when the chunk is not known); any other exception passes unchanged.
+    """
+    try:
+        yield
+    except (RuntimeError, ValueError, zlib.error) as exc:
+        if not _is_codec_error(exc):
+            raise
+        what = f"chunk {chunk}" if chunk else f"a chunk of variable {name}"
+        raise EulerPoissonError(
+            f"{store} is not a readable Zarr store: {what} is corrupt ({exc}); write the store again"
+        ) from exc
 
 
 def _zstd_content_size(raw) -> int | None:
@@ -195,6 +243,7 @@ class _DirectChunks:
         self.compressed = compressed
         self.fill = arr.fill_value
         self.nbytes = int(np.prod(self.chunks)) * dtype.itemsize
+        self.name = str(arr.path).strip("/")
 
     @classmethod
     def of(cls, arr, axis: int):
@@ -238,7 +287,8 @@ class _DirectChunks:
         """Chunk ``k`` (full chunk shape), decoded into ``out`` (C-contiguous, native) when given."""
         coords = [0] * len(self.shape)
         coords[self.axis] = k
-        fn = self.root.joinpath(*self.key(tuple(coords)).split("/"))
+        key = self.key(tuple(coords))
+        fn = self.root.joinpath(*key.split("/"))
         try:
             with open(fn, "rb", buffering=0) as fh:
                 size = os.fstat(fh.fileno()).st_size
@@ -268,9 +318,9 @@ class _DirectChunks:
                     return out
                 raw = memoryview(decompress(raw))
             except Exception as exc:  # noqa: BLE001 - not what we wrote: zarr reads it (and says what is wrong)
-                raise _NotDirect(str(exc)) from exc
+                raise _NotDirect(str(exc), f"{self.name}/{key}") from exc
         if raw.nbytes != self.nbytes:
-            raise _NotDirect(f"chunk {k} holds {raw.nbytes} bytes, expected {self.nbytes}")
+            raise _NotDirect(f"chunk {k} holds {raw.nbytes} bytes, expected {self.nbytes}", f"{self.name}/{key}")
         x = np.frombuffer(raw, self.dtype).reshape(self.chunks)
         if out is None:
             return x.astype(self.native)  # a copy: the buffer is reused
@@ -352,9 +402,11 @@ class StoredArray:
     ``a[-1]``); ``numpy.asarray(a)`` reads everything.
     """
 
-    def __init__(self, arr: Any, batch_shape: tuple[int, ...]) -> None:
+    def __init__(self, arr: Any, batch_shape: tuple[int, ...], *, store: str | os.PathLike[str] | None = None) -> None:
         self._arr = arr
         self._bshape = tuple(batch_shape)
+        self._store = store if store is not None else getattr(getattr(arr, "store", None), "root", "the store")
+        self._name = str(getattr(arr, "path", "") or "?").strip("/")
         shp = tuple(arr.shape)
         self.shape = self._bshape + shp[1:] if self._bshape else shp
         self.dtype = np.dtype(arr.dtype)
@@ -383,25 +435,29 @@ class StoredArray:
         axis = 1 if self._bshape else 0
         if self._direct is None:
             self._direct = _DirectChunks.of(self._arr, axis) or False
+        chunk = None
         if self._direct and (step or 1) > 0:
             try:
                 x = self._direct.read(*sl.indices(int(self._arr.shape[axis])), out=out)
-            except _NotDirect:
-                pass
+            except _NotDirect as exc:
+                chunk = exc.chunk  # the chunk it could not decode: named if zarr cannot either
             else:
                 return x.reshape(self._bshape + x.shape[1:]) if self._bshape else x
-        if self._bshape:
-            x = np.asarray(self._arr[:, sl])
-            return x.reshape(self._bshape + x.shape[1:])
-        return np.asarray(self._arr[sl])
+        with _decoding(self._store, self._name, chunk):
+            if self._bshape:
+                x = np.asarray(self._arr[:, sl])
+                return x.reshape(self._bshape + x.shape[1:])
+            return np.asarray(self._arr[sl])
 
     def __getitem__(self, index: Any) -> NDArray[np.float64]:
         if not self._bshape:
-            return np.asarray(self._arr[index])
+            with _decoding(self._store, self._name):
+                return np.asarray(self._arr[index])
         return np.asarray(self)[index]  # batches are small stores in practice
 
     def __array__(self, dtype=None, copy=None):
-        x = np.asarray(self._arr[...])
+        with _decoding(self._store, self._name):
+            x = np.asarray(self._arr[...])
         if self._bshape:
             x = x.reshape(self.shape)
         return x if dtype is None else x.astype(dtype)
@@ -553,7 +609,8 @@ class LazyTrajectory:
                     f"{path}: variable {nm} has shape {tuple(g[nm].shape)}, expected {lead + (T,) + tail} "
                     f"(batch_shape {list(self.batch_shape)}, {T} times)"
                 )
-        inertia = np.asarray(g["inertia"][...], dtype=float)
+        with _decoding(path, "inertia"):
+            inertia = np.asarray(g["inertia"][...], dtype=float)
         if inertia.shape != lead + (3, 3):
             raise InvalidInputError(f"{path}: variable inertia has shape {inertia.shape}, expected {lead + (3, 3)}")
         if self.batch_shape:
@@ -561,11 +618,10 @@ class LazyTrajectory:
         name = attrs.get("body_name") or None
         try:
             if "particle_masses" in names:
-                body = RigidBody.from_particles(
-                    np.asarray(g["particle_masses"][...]),
-                    np.asarray(g["particle_positions"][...]) + np.asarray(g["center_of_mass"][...]),
-                    name=None if name is None else str(name),
-                )
+                with _decoding(path, "particle_masses, particle_positions or center_of_mass"):
+                    masses = np.asarray(g["particle_masses"][...])
+                    positions = np.asarray(g["particle_positions"][...]) + np.asarray(g["center_of_mass"][...])
+                body = RigidBody.from_particles(masses, positions, name=None if name is None else str(name))
             else:
                 body = RigidBody(inertia, name=None if name is None else str(name), allow_unphysical=True)
             self.model = Model(body, read_torques(path, ds))
@@ -574,9 +630,9 @@ class LazyTrajectory:
         self.body = body
         self.T = T
         self.chunk = int(tarr.chunks[0]) if T else 1
-        self.t = StoredArray(tarr, ())
-        self.quaternion = StoredArray(g["quaternion"], self.batch_shape)
-        self.omega = StoredArray(g["omega"], self.batch_shape)
+        self.t = StoredArray(tarr, (), store=path)
+        self.quaternion = StoredArray(g["quaternion"], self.batch_shape, store=path)
+        self.omega = StoredArray(g["omega"], self.batch_shape, store=path)
         self.attrs = attrs
         self._grid = None
         if T:
@@ -593,7 +649,7 @@ class LazyTrajectory:
             raise KeyError(f"{self.path} has no variable {name!r} (it has {', '.join(self.variables)})")
         cache = self.__dict__.setdefault("_stored", {"quaternion": self.quaternion, "omega": self.omega})
         if name not in cache:
-            cache[name] = StoredArray(self._group[name], self.batch_shape)
+            cache[name] = StoredArray(self._group[name], self.batch_shape, store=self.path)
         return cache[name]
 
     def _check_unit(self, q: np.ndarray, where: str) -> None:

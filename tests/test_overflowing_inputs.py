@@ -69,3 +69,20 @@ def test_rk_stops_at_the_first_non_finite_right_hand_side():
     big = ep.torques.CallableTorque(lambda t, q, w: np.full(np.shape(w), 1e308))
     with pytest.raises(EulerPoissonError, match=r"rk: the right-hand side is not finite at t = 0"):
         ep.solve([1.0, 1.0, 0.5], [0.0, 1.0], omega0=[0.0, 0.2, 2.0], torque=big, method="rk")
+
+
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        ({"g": [0.0, 0.0, -1e160]}, r"exceeds 2\^48"),
+        ({"mass": 1e300, "g": [0.0, 0.0, -1e10]}, r"mass \* \|g\| \* \|ell\| overflows float64"),
+        ({"w0": [0.1, 0.0, 1e300]}, r"squared frequency .* overflows float64"),
+    ],
+)
+def test_jax_lagrange_top_refuses_the_same_before_compiling(change, match):
+    pytest.importorskip("jax", reason="jax is not installed: pip install 'eulerpoisson[jax]'")
+    from eulerpoisson.jax import lagrange_top_motion as jax_top
+
+    a = {**TOP, "t": T, **change}
+    with pytest.raises(InvalidInputError, match=match):
+        jax_top(a["A"], a["C"], a["mass"], a["ell"], a["g"], a["q0"], a["w0"], a["t"])

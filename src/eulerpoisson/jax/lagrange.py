@@ -35,8 +35,10 @@ import functools
 
 import jax
 import jax.numpy as jnp
+import numpy as np
 
 from ..errors import InvalidInputError
+from ..solvers.exact.lagrange import check_top_ranges
 from .doubledouble import safe_sqrt, straight
 from .elliptic import ellipk_dd, jacobi_params, rf, rj, sncndn_dd
 from .precision import as_float, float64_by_default
@@ -456,7 +458,9 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, dtype=None):
     InvalidInputError
         Wrong trailing dimensions, ``t`` not 1-D, shapes that do not broadcast, non-numeric input;
         with concrete (not traced) values also ``A <= 0``, ``C <= 0``, ``C > 2 A``, ``mass < 0``,
-        non-finite values or ``q0`` not of unit norm.
+        non-finite values or ``q0`` not of unit norm, and finite values whose gravity scale
+        ``mass |g| |ell|`` or squared frequency overflows float64, or whose phase ``W |t|`` exceeds
+        2^48 (as the NumPy :func:`eulerpoisson.solvers.exact.lagrange.lagrange_top_motion`).
     PrecisionError
         Traced in float64 with 64-bit floats off.
 
@@ -506,6 +510,8 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, dtype=None):
         _check(C > 0.0, "C must be > 0")
         _check(C <= 2.0 * A, "C must satisfy C <= 2 A (triangle inequality A + A >= C)")
         _check(mass >= 0.0, "mass must be >= 0")
+        # finite values whose products leave float64: an error (as the NumPy twin), not a free top or NaN
+        check_top_ranges(*(np.asarray(x, dtype=np.float64) for x in (A, mass, ell, g, omega0, t)))
     return _motion(A, C, mass, ell, g, q0, omega0, t, shape=shape)
 
 

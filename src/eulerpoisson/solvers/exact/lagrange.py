@@ -145,7 +145,7 @@ from ...errors import InvalidInputError
 from ...numerics.elliptic import ellipk, elliprf, elliprj, jacobi_sncndn
 from ...numerics.quaternion import CONJUGATE, qmul
 
-__all__ = ["lagrange_top_motion"]
+__all__ = ["lagrange_top_motion", "check_top_ranges"]
 
 _UNIT_TOL = 1e-8
 _BRACKET_ITERS = 200
@@ -677,12 +677,34 @@ def _per_time(c, tt):
 _MAX_PHASE = 2.0**48
 
 
-def _check_ranges(P: np.ndarray, A: np.ndarray, omega0: np.ndarray, t: np.ndarray) -> None:
-    """Refuse finite inputs whose gravity scale, frequency or phase leaves float64 (flattened bodies ``(Nb,)``).
+def check_top_ranges(A, mass, ell, g, omega0, t) -> None:
+    r"""Refuse finite inputs of a Lagrange top whose gravity scale, frequency or phase leaves float64.
 
-    Without this, an overflowing gravity scale ``P`` made the top free (a silent wrong answer) and an
-    overflowing frequency or phase gave NaN.
+    ``A``, ``mass``, ``ell`` (...), ``g`` and ``omega0`` (..., 3), broadcasting; ``t`` (T,). Without
+    this, an overflowing gravity scale ``P = mass |g| |ell|`` made the top free (a silent wrong answer) and
+    an overflowing frequency or phase gave NaN (in :func:`lagrange_top_motion` and its JAX twin).
+
+    Raises
+    ------
+    InvalidInputError
+        ``P`` or the squared frequency :math:`W^2 = P/A + |\Omega_0|^2` overflows, or :math:`W|t| > 2^{48}`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_top_ranges(np.ones(1), np.ones(1), np.ones(1), np.array([[0, 0, -9.81]]), np.zeros((1, 3)), np.ones(2))
+    >>> check_top_ranges(np.ones(1), np.ones(1), np.ones(1), np.array([[0, 0, -1e300]]), np.zeros((1, 3)), np.ones(2))
+    Traceback (most recent call last):
+    ...
+    eulerpoisson.errors.InvalidInputError: W |t| = 1e+150 (body 0 of the flattened batch, ...
     """
+    A, mass, ell = (np.asarray(x, dtype=float) for x in (A, mass, ell))
+    omega0 = np.asarray(omega0, dtype=float)
+    g = np.asarray(g, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        gmax = np.max(np.abs(g), axis=-1, initial=0.0)
+        gs = np.where(gmax > 0.0, gmax, 1.0)
+        P = mass * (gmax * np.sqrt(np.sum((g / gs[..., None]) ** 2, axis=-1))) * np.abs(ell)
     bad = ~np.isfinite(P)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
@@ -694,7 +716,7 @@ def _check_ranges(P: np.ndarray, A: np.ndarray, omega0: np.ndarray, t: np.ndarra
         # |omega0|^2 scaled like |g| (no overflow of the squares for |omega0| below 1e308)
         wmax = np.max(np.abs(omega0), axis=-1, initial=0.0)
         ws = np.where(wmax > 0.0, wmax, 1.0)
-        w2 = wmax * wmax * np.sum((omega0 / ws[:, None]) ** 2, axis=-1)
+        w2 = wmax * wmax * np.sum((omega0 / ws[..., None]) ** 2, axis=-1)
         W2 = P / A + w2
         tmax = float(np.max(np.abs(t), initial=0.0))
         phase = np.sqrt(W2) * tmax
@@ -709,7 +731,7 @@ def _check_ranges(P: np.ndarray, A: np.ndarray, omega0: np.ndarray, t: np.ndarra
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(
-            f"W |t| = {phase[i]:.3g} (body {i} of the flattened batch, W the top's frequency "
+            f"W |t| = {np.ravel(phase)[i]:.3g} (body {i} of the flattened batch, W the top's frequency "
             f"sqrt(mass |g| |ell| / A + |omega0|^2), |t| = {tmax:.6g}) exceeds 2^48 = {_MAX_PHASE:.3g} rad: "
             "float64 no longer determines the phase of the motion there"
         )
@@ -821,7 +843,7 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
         gn = np.where(np.isfinite(gn), gn, gmax * np.linalg.norm(g_ / gs[:, None], axis=-1))
     with np.errstate(over="ignore"):
         P = mass_ * gn * np.abs(ell_)
-    _check_ranges(P, A_, om_, t)
+    check_top_ranges(A_, mass_, ell_, g_, om_, t)
     # scales: frequency W ~ sqrt(P/A + |Omega0|^2) and inertia S ~ A, both
     # powers of two (the rescaling is exact); in the units t' = W t,
     # Omega' = Omega/W, A' = A/S, P' = P/(S W^2) the problem is O(1).  A gravity

@@ -86,3 +86,16 @@ def test_jax_lagrange_top_refuses_the_same_before_compiling(change, match):
     a = {**TOP, "t": T, **change}
     with pytest.raises(InvalidInputError, match=match):
         jax_top(a["A"], a["C"], a["mass"], a["ell"], a["g"], a["q0"], a["w0"], a["t"])
+
+
+def test_gibbs_maps_refuse_a_result_that_overflows():
+    """Before: NaN entries (matrix_from_conversion) and inf rates for finite n, where the siblings raised."""
+    from eulerpoisson.attitude import gibbs_rate_from_omega, matrix_from_conversion, matrix_from_gibbs
+
+    with pytest.raises(InvalidInputError, match=r"matrix_from_conversion overflows float64 .*max \|n\| = 1e\+200"):
+        matrix_from_conversion([1e200, 0.0, 0.0])
+    np.testing.assert_allclose(matrix_from_gibbs([1e200, 0.0, 0.0]), np.diag([1.0, -1.0, -1.0]), atol=1e-15)
+    with pytest.raises(InvalidInputError, match=r"gibbs_rate_from_omega overflows float64"):
+        gibbs_rate_from_omega([1e200, 1e200, 0.0], [1.0, 0.0, 0.0])
+    n = [0.1, 0.2, 0.3]  # ordinary values unchanged
+    np.testing.assert_allclose(matrix_from_conversion(n), matrix_from_gibbs(n), rtol=0, atol=1e-15)

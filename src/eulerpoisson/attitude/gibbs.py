@@ -579,7 +579,9 @@ def matrix_from_conversion(n: ArrayLike) -> NDArray[np.float64]:
     Raises
     ------
     InvalidInputError
-        Wrong shape or non-finite values.
+        Wrong shape or non-finite values; a result that overflows float64
+        (:math:`|\mathbf n|` beyond about 1e154: :func:`matrix_from_gibbs`
+        evaluates those).
 
     References
     ----------
@@ -594,7 +596,9 @@ def matrix_from_conversion(n: ArrayLike) -> NDArray[np.float64]:
     True
     """
     n = as_float_array(n, "n", (3,))
-    return _A(n) @ np.swapaxes(_At(n), -1, -2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = _A(n) @ np.swapaxes(_At(n), -1, -2)
+    return finite_result(out, "matrix_from_conversion", n=n)
 
 
 def omega_from_gibbs_rate(n: ArrayLike, ndot: ArrayLike) -> NDArray[np.float64]:
@@ -632,7 +636,9 @@ def omega_from_gibbs_rate(n: ArrayLike, ndot: ArrayLike) -> NDArray[np.float64]:
     n = as_float_array(n, "n", (3,))
     nd = as_float_array(ndot, "ndot", (3,))
     check_broadcast(n=n, ndot=nd)
-    return 2.0 * np.einsum("...ji,...j->...i", _A(n), nd)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = 2.0 * np.einsum("...ji,...j->...i", _A(n), nd)
+    return finite_result(out, "omega_from_gibbs_rate", n=n, ndot=nd)
 
 
 def gibbs_rate_from_omega(n: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]:
@@ -670,7 +676,9 @@ def gibbs_rate_from_omega(n: ArrayLike, omega: ArrayLike) -> NDArray[np.float64]
     w = as_float_array(omega, "omega", (3,))
     check_broadcast(n=n, omega=w)
     n, w = np.broadcast_arrays(n, w)
-    return 0.5 * (w + np.cross(n, w) + np.sum(n * w, -1)[..., None] * n)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = 0.5 * (w + np.cross(n, w) + np.sum(n * w, -1)[..., None] * n)
+    return finite_result(out, "gibbs_rate_from_omega", n=n, omega=w)
 
 
 def _inertia_arrays(inertia, inverse: bool = False):

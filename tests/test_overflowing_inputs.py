@@ -99,3 +99,14 @@ def test_gibbs_maps_refuse_a_result_that_overflows():
         gibbs_rate_from_omega([1e200, 1e200, 0.0], [1.0, 0.0, 0.0])
     n = [0.1, 0.2, 0.3]  # ordinary values unchanged
     np.testing.assert_allclose(matrix_from_conversion(n), matrix_from_gibbs(n), rtol=0, atol=1e-15)
+
+
+def test_exact_phase_message_names_the_quantity():
+    """|omega0| beyond 1e154 is reported as itself (its square overflowed: it said inf), a heavy top's rate as such."""
+    with pytest.raises(InvalidInputError, match=r"exact: \|omega0\| \|t\| = 1e\+300 exceeds 2\^48"):
+        ep.solve([1.0, 2.0, 3.0], [0.0, 1.0], omega0=[1e300, 0.1, 0.5], method="exact")
+    top = ep.torques.Gravity(1.0, [0.0, 0.0, 0.3], [0.0, 0.0, -1e100])
+    with pytest.raises(
+        InvalidInputError, match=r"exact: \(\|omega0\| \+ sqrt\(mass \|g\| \|ell\| / A\)\) \|t\| = 5\.48e\+49"
+    ):
+        ep.solve(ep.RigidBody([1.0, 1.0, 0.5]), [0.0, 1.0], omega0=[0.0, 0.2, 20.0], torque=top, method="exact")

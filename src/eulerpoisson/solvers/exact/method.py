@@ -87,11 +87,19 @@ def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
         )
         if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
             return
-        w2 = np.sum(w * w, axis=-1)
+        with np.errstate(over="ignore"):
+            w2 = np.sum(w * w, axis=-1)
         # the common case in one pass: every |Omega0| t well inside the range (no square roots)
         if tmax == 0.0 or float(np.max(w2, initial=0.0)) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
             return
         speed = np.sqrt(w2)
+        if not np.all(np.isfinite(speed)):  # |Omega0| beyond 1e154: its square overflowed, not the rate
+            from ...model.torque_base import scaled_norms
+
+            speed = scaled_norms(w)
+        what = "|omega0| |t|"
+    else:
+        what = "(|omega0| + sqrt(mass |g| |ell| / A)) |t|"  # a heavy top's rate
     with np.errstate(over="ignore"):
         phase = speed * tmax
     if np.any(phase > MAX_PHASE):
@@ -99,7 +107,7 @@ def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
         i = int(np.argmax(flat))
         where = f" (body {tuple(int(k) for k in np.unravel_index(i, phase.shape))})" if phase.ndim else ""
         raise InvalidInputError(
-            f"exact: |omega0| |t| = {flat[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad: at |t| = {tmax:.6g} "
+            f"exact: {what} = {flat[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad: at |t| = {tmax:.6g} "
             f"the rounding of the frequencies (a few ulp) already shifts the phase of the motion by more than "
             f"0.1 rad, so float64 cannot say where on its orbit the body is; use shorter times"
         )

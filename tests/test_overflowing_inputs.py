@@ -110,3 +110,17 @@ def test_exact_phase_message_names_the_quantity():
         InvalidInputError, match=r"exact: \(\|omega0\| \+ sqrt\(mass \|g\| \|ell\| / A\)\) \|t\| = 5\.48e\+49"
     ):
         ep.solve(ep.RigidBody([1.0, 1.0, 0.5]), [0.0, 1.0], omega0=[0.0, 0.2, 20.0], torque=top, method="exact")
+
+
+@pytest.mark.parametrize("angle", [1e-140, 1e-160, 1e-170, 1e-250, 1e-300])
+def test_tiny_angles_keep_their_axis_and_size(angle):
+    """Below 1e-154 the squares of the vector part are subnormal: the axis was not unit, then the angle 0."""
+    from eulerpoisson.attitude import axis_angle_from_quaternion, quaternion_from_rotvec
+
+    k0 = np.array([0.48, -0.6, 0.64])  # a unit axis
+    q = quaternion_from_rotvec(angle * k0)
+    k, a = axis_angle_from_quaternion(q)
+    np.testing.assert_allclose(k, k0, rtol=0, atol=4e-16)
+    assert a == pytest.approx(angle, rel=4e-16)
+    assert ep.Attitude(q).magnitude() == pytest.approx(angle, rel=4e-16)
+    assert ep.Attitude(q).angle_to(ep.Attitude([1.0, 0.0, 0.0, 0.0])) == pytest.approx(angle, rel=4e-16)

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from ..numerics.quaternion import qmul
 from ..util.validate import as_bool, as_float_array, as_shape, check_broadcast
-from .common import norm
+from .common import scaled_norm
 from .euler import euler_from_quaternion, quaternion_from_euler
 from .gibbs import gibbs_chart, gibbs_from_unit_quaternion, quaternion_from_chart, quaternion_from_gibbs
 from .quaternion import (
@@ -516,7 +516,7 @@ class Attitude:
         other = _check_attitude(other)
         check_broadcast(self=self._q, other=other._q)
         rel = qmul(self._q * CONJUGATE_SIGNS, other._q)
-        return 2.0 * np.arctan2(norm(rel[..., 1:]), np.abs(rel[..., 0]))
+        return 2.0 * np.arctan2(scaled_norm(rel[..., 1:]), np.abs(rel[..., 0]))
 
     # container ------------------------------------------------------------
     @property

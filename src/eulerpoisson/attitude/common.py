@@ -98,6 +98,25 @@ def norm(v):
     return np.sqrt(np.sum(v * v, axis=-1))
 
 
+def scaled_norm(v):
+    """Euclidean norms over the last axis, also where the squares underflow or overflow.
+
+    The plain :func:`norm` (its bits) where the sum of squares is safely inside float64; scaled by the
+    largest component elsewhere (vectors below about 1e-146 or above 1e146), where the plain sum loses
+    digits to subnormal squares or overflows.
+    """
+    v = np.asarray(v)
+    with np.errstate(over="ignore", under="ignore"):
+        s2 = np.sum(v * v, axis=-1)
+    out = np.sqrt(s2)
+    risky = ~((s2 > 2.0**-968) & (s2 < 2.0**968))
+    if np.any(risky & np.any(v != 0, axis=-1)):
+        m = np.max(np.abs(v), axis=-1)
+        safe = np.where(m > 0, m, 1.0)
+        out = np.where(risky, m * np.sqrt(np.sum((v / safe[..., None]) ** 2, axis=-1)), out)
+    return out
+
+
 def pow2_below(m):
     """Largest power of two <= m (m > 0 finite); division by it is exact."""
     _, e = np.frexp(m)

@@ -33,7 +33,7 @@ from ..errors import InvalidInputError
 from ..numerics.doubledouble import sum_of_squares as _sumsq_dd
 from ..numerics.doubledouble import two_prod as _two_prod
 from ..util.validate import as_float_array
-from .common import first_index, norm, pow2_below
+from .common import first_index, norm, pow2_below, scaled_norm
 from .gibbs import gibbs_from_unit_quaternion, quaternion_from_gibbs
 from .quaternion import as_quaternion, canonical_unit_quaternion
 
@@ -141,7 +141,7 @@ def axis_angle_from_quaternion(q: ArrayLike) -> tuple[NDArray[np.float64], NDArr
     """
     q = canonical_unit_quaternion(as_quaternion(q))
     v = q[..., 1:]
-    s = norm(v)
+    s = scaled_norm(v)  # (angles below 1e-146: the plain norm's squares are subnormal)
     angle = 2.0 * np.arctan2(s, q[..., 0])
     safe = np.where(s > 0, s, 1.0)
     axis = np.where((s > 0)[..., None], v / safe[..., None], np.array([0.0, 0.0, 1.0]))

@@ -124,3 +124,17 @@ def test_tiny_angles_keep_their_axis_and_size(angle):
     assert a == pytest.approx(angle, rel=4e-16)
     assert ep.Attitude(q).magnitude() == pytest.approx(angle, rel=4e-16)
     assert ep.Attitude(q).angle_to(ep.Attitude([1.0, 0.0, 0.0, 0.0])) == pytest.approx(angle, rel=4e-16)
+
+
+def test_messages_name_what_is_wrong(tmp_path):
+    """A bool max_steps is not an integer; a folder of the output path that is a file is named as such."""
+    from eulerpoisson.io.atomic import write_error
+
+    with pytest.raises(TypeError, match="max_steps must be an integer, got bool True"):
+        ep.solve([1.0, 2.0, 3.0], [0.0, 1.0], omega0=[1.0, 0.1, 0.5], method="taylor", max_steps=True)
+    (tmp_path / "notes.txt").write_text("mine")
+    dest = tmp_path / "notes.txt" / "sub" / "run.nc"
+    err = write_error(dest, FileExistsError(17, "File exists", str(tmp_path / "notes.txt")))
+    assert isinstance(err, FileExistsError)
+    assert str(err).endswith(f"cannot write {dest}: {tmp_path / 'notes.txt'} is a file, not a folder")
+    assert (tmp_path / "notes.txt").read_text() == "mine"

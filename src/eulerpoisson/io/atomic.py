@@ -66,6 +66,11 @@ def write_error(dest, exc: OSError) -> OSError:
     '[Errno 30] cannot write out/r.nc: Read-only file system; its file system is read-only: write to a folder on a writable disk'
     """
     reason = exc.strerror or str(exc) or type(exc).__name__
+    if exc.errno in (_errno.EEXIST, _errno.ENOTDIR):
+        # a folder of the path is a file ("File exists" from mkdir, "Not a directory" from open)
+        blocking = next((p for p in Path(os.fspath(dest)).parents if p.exists()), None)
+        if blocking is not None and not blocking.is_dir():
+            return OSError(exc.errno, f"cannot write {dest}: {blocking} is a file, not a folder")
     advice = WRITE_ADVICE.get(exc.errno) if exc.errno is not None else None
     if advice and advice not in reason:
         reason = f"{reason}; {advice}"

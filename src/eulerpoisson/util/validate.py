@@ -84,7 +84,8 @@ def as_scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False
         if isinstance(x, np.ndarray) and x.ndim == 0:
             x = x.item()
         else:
-            raise TypeError(f"{name} must be a real number, got {type(x).__name__} {x!r}")
+            kind = "an integer" if integer else "a real number"
+            raise TypeError(f"{name} must be {kind}, got {type(x).__name__} {x!r}")
     v = float(x)
     if not np.isfinite(v):
         raise InvalidInputError(f"{name} must be finite, got {v!r}")

@@ -108,7 +108,7 @@ def test_never_an_input_nor_a_file_of_another_kind(capsys, tmp_path):
     notes = tmp_path / "notes.zarr"
     notes.write_text("my notes")
     code, _, err = run(capsys, *SIM, "--out", str(notes), "--overwrite")
-    assert code == 2 and "it is a file that is not NetCDF" in err and notes.read_text() == "my notes"
+    assert code == 2 and "it is a file, not a Zarr store (a folder) of ours" in err and notes.read_text() == "my notes"
     nc = tmp_path / "run.nc"
     ep.solve([1, 2, 3], [0.0, 1.0], omega0=[1, 0, 0]).to_netcdf(nc)
     code, _, err = run(capsys, "audit", "--out", str(nc), "--overwrite")

@@ -138,3 +138,27 @@ def test_messages_name_what_is_wrong(tmp_path):
     assert isinstance(err, FileExistsError)
     assert str(err).endswith(f"cannot write {dest}: {tmp_path / 'notes.txt'} is a file, not a folder")
     assert (tmp_path / "notes.txt").read_text() == "mine"
+
+
+def test_plot_and_sweep_outputs_say_what_is_wrong(tmp_path, capsys):
+    """plot --out p.jpg names the flag (not the library's out=); sweep --out onto a file says a store is a folder."""
+    from eulerpoisson.cli.commands import main
+
+    run = tmp_path / "run.nc"
+    assert main(["simulate", "--inertia", "1,2,3", "--omega", "1,0.1,0.5", "--t-end", "1", "--out", str(run)]) == 0
+    capsys.readouterr()
+    assert main(["plot", str(run), "--kind", "omega", "--out", str(tmp_path / "p.jpg")]) == 2
+    err = capsys.readouterr().err
+    assert "--out" in err and "unsupported file extension '.jpg'; use one of .png" in err and "out=" not in err
+    mine = tmp_path / "mycode.py"
+    mine.write_text("print(1)")
+    cfg = tmp_path / "sweep.toml"
+    cfg.write_text(
+        "[sweep]\nkind = 'grid'\n[inertia]\nI1 = 1.0\nI2 = 2.0\nI3 = 3.0\n"
+        "[momentum]\npolar = {start = 10.0, stop = 170.0, num = 3}\nazimuth = {start = 0.0, stop = 90.0, num = 2}\n"
+        "degrees = true\n[output]\npath = 'x.zarr'\n[compute]\nT = 1.0\nscheduler = 'serial'\n"
+    )
+    code = main(["sweep", str(cfg), "--out", str(mine), "--overwrite"])
+    err = capsys.readouterr().err
+    assert code == 2 and "it is a file, not a Zarr store (a folder) of ours" in err, err
+    assert mine.read_text() == "print(1)"

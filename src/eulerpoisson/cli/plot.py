@@ -46,6 +46,13 @@ def cmd_plot(args) -> int:
     # the same output policy as simulate: an existing figure is replaced only with --overwrite, never the input
     # or a file of another kind; the figure is claimed before the trajectory is read
     with claim_output(out, "figure", overwrite=bool(args.overwrite), inputs=[args.file], option="--out"):
+        from ..viz.plots import FORMATS
+
+        if Path(out).suffix.lower().lstrip(".") not in FORMATS:  # (the flag's name, not the library's out=)
+            raise UsageError(
+                f"--out {out!r}: unsupported file extension {Path(out).suffix!r}; use one of "
+                + ", ".join("." + f for f in FORMATS)
+            )
         if args.kind == "atlas":
             from ..io.outputs import file_kind
             from ..sweep.runner import load_sweep, plot_atlas

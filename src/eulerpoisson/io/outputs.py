@@ -411,8 +411,10 @@ def check_output(
         )
     if have not in REPLACES[writes]:
         what = _DESCRIPTION.get(have, "a " + have)
-        if have == "file" and writes in ("netcdf", "trajectory-store", "sweep-store"):
+        if have == "file" and writes == "netcdf":
             what = "a file that is not NetCDF (a configuration, data, text?)"
+        elif have == "file" and writes in ("trajectory-store", "sweep-store"):
+            what = "a file, not a Zarr store (a folder) of ours (a configuration, data, text?)"
         raise OutputError(
             f"refusing to replace {path}: it is {what}, and this command writes "
             f"{_WRITES[writes]} ({flag} replaces only an output of the same kind; delete it yourself or "

@@ -116,3 +116,13 @@ def test_traced_inputs_are_only_shape_checked():
         assert out[0].shape == (2, 4)
         with pytest.raises(InvalidInputError, match="omega0 must have shape"):
             jax.eval_shape(lambda w: exact_motion(I3, Q0, w, T), jnp.zeros(2))
+
+
+def test_booleans_are_not_numbers():
+    """As ep.solve: omega0=[True, False, True] or A=True is an error naming the argument, not 1.0 and 0.0."""
+    from eulerpoisson.jax import lagrange_top_motion
+
+    with pytest.raises(InvalidInputError, match=r"omega0 must be a real array, got dtype bool"):
+        exact_motion([1.0, 2.0, 3.0], [1.0, 0.0, 0.0, 0.0], [True, False, True], [0.0, 1.0])
+    with pytest.raises(InvalidInputError, match=r"A must be a real array, got dtype bool"):
+        lagrange_top_motion(True, 0.5, 1.0, 0.3, [0, 0, -9.81], [1, 0, 0, 0], [0.1, 0.0, 20.0], [0.0, 1.0])

@@ -139,6 +139,6 @@ def as_float(x, dtype, name: str):
         arr = np.asarray(x)
     except (TypeError, ValueError) as exc:
         raise InvalidInputError(f"{name} must be a real array, got {x!r}") from exc
-    if arr.dtype.kind not in "fiub":
+    if arr.dtype.kind not in "fiu":  # (booleans too: as eulerpoisson.solve refuses them)
         raise InvalidInputError(f"{name} must be a real array, got dtype {arr.dtype} ({x!r})")
     return jnp.asarray(arr, dtype=dtype)

@@ -126,3 +126,14 @@ def test_booleans_are_not_numbers():
         exact_motion([1.0, 2.0, 3.0], [1.0, 0.0, 0.0, 0.0], [True, False, True], [0.0, 1.0])
     with pytest.raises(InvalidInputError, match=r"A must be a real array, got dtype bool"):
         lagrange_top_motion(True, 0.5, 1.0, 0.3, [0, 0, -9.81], [1, 0, 0, 0], [0.1, 0.0, 20.0], [0.0, 1.0])
+
+
+def test_integrate_refuses_torque_parameters_that_overflow_together():
+    """As ep.solve: a Gravity of mass 1e300 at 1e300 is an error before anything runs (it gave NaN)."""
+    import eulerpoisson as ep
+
+    top = ep.torques.Gravity(1e300, [0.0, 0.0, 1e300])
+    with pytest.raises(InvalidInputError, match="torque Gravity overflows float64"):
+        integrate([1.0, 1.0, 0.5], [1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0], 0.5, 10, top)
+    with pytest.raises(InvalidInputError, match="torque GravityGradient overflows float64"):
+        integrate([1.0, 1.0, 0.5], [1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0], 0.5, 10, [ep.torques.GravityGradient(1e200)])

@@ -56,6 +56,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..errors import InvalidInputError
+from ..model.torque_base import Torque, check_torque_scales
 from .exact import check_inputs, check_phase, normalized
 from .precision import as_float, float64_by_default
 from .quaternion import qconj as _conj
@@ -344,6 +345,10 @@ def integrate(
         tq = jax.tree_util.tree_map(lambda x: as_float(x, dt, "torque parameter"), tq)
     flow = _free_flow if _free_flow is not None else _exact_flow(dt)
     I = as_float(inertia, dt, "inertia")
+    given = [x for x in (torque if isinstance(torque, (list, tuple)) else [torque]) if isinstance(x, Torque)]
+    if given and not isinstance(I, jax.core.Tracer):
+        # parameters of eulerpoisson.torques that overflow together: an error, as eulerpoisson.solve gives
+        check_torque_scales(given, float(np.max(np.abs(np.asarray(I, dtype=np.float64)), initial=0.0)))
     q0 = as_float(quaternion0, dt, "quaternion0")
     w0 = as_float(omega0, dt, "omega0")
     te = as_float(t_end, dt, "t_end")

@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidInputError
-from ..util.validate import as_float_array
+from ..util.validate import as_float_array, scaled_norms
 
 __all__ = ["skew", "unskew"]
 
@@ -111,9 +111,7 @@ def scaled_norm(v):
     out = np.sqrt(s2)
     risky = ~((s2 > 2.0**-968) & (s2 < 2.0**968))
     if np.any(risky & np.any(v != 0, axis=-1)):
-        m = np.max(np.abs(v), axis=-1)
-        safe = np.where(m > 0, m, 1.0)
-        out = np.where(risky, m * np.sqrt(np.sum((v / safe[..., None]) ** 2, axis=-1)), out)
+        out = np.where(risky, scaled_norms(v), out)
     return out
 
 

@@ -35,6 +35,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..errors import InvalidInertiaError, InvalidInputError
+from ..util.validate import MAX_PHASE
 from .doubledouble import (
     dd_add,
     dd_mul,
@@ -558,11 +559,6 @@ def _quat_from_rotation(R):
 # ---------------------------------------------------------------------------
 def _is_tracer(x) -> bool:
     return isinstance(x, jax.core.Tracer)
-
-
-#: the largest :math:`|\Omega_0||t|` the closed form accepts (``ep.solve(..., method="exact")``'s limit: beyond
-#: it the rounding of the frequencies shifts the phase of the motion by more than 0.1 rad)
-MAX_PHASE = 2.0**48
 
 
 def normalized(q):

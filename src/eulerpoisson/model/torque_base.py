@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from ..errors import InvalidInputError
-from ..util.validate import as_float_array
+from ..util.validate import as_float_array, scaled_norms
 
 if TYPE_CHECKING:
     from .equations import Model
@@ -82,22 +82,6 @@ def z_rotation_quaternion(phi: ArrayLike) -> NDArray[np.float64]:
     """
     phi = np.asarray(phi, dtype=float)
     return np.stack([np.cos(phi / 2), np.zeros_like(phi), np.zeros_like(phi), np.sin(phi / 2)], -1)
-
-
-def scaled_norms(a: ArrayLike, axes: int | tuple[int, int] = -1) -> NDArray[np.float64]:
-    """Euclidean (Frobenius) norms over ``axes`` without overflow in the squares (inf only when the norm is).
-
-    Examples
-    --------
-    >>> round(float(scaled_norms([3e200, 4e200, 0.0])) / 1e200, 12)
-    5.0
-    """
-    a = np.abs(np.asarray(a, dtype=float))
-    top = np.max(a, axis=axes, keepdims=True)
-    safe = np.where(top > 0, top, 1.0)
-    return (
-        np.squeeze(safe, axis=axes) * np.sqrt(np.sum(np.square(a / safe), axis=axes)) * (np.squeeze(top, axis=axes) > 0)
-    )
 
 
 def torque_bound(tq: Torque, inertia_max: float) -> float | None:

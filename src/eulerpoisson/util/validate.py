@@ -5,8 +5,13 @@ from __future__ import annotations
 import numbers
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError
+
+#: the largest phase (rad) of a motion, |Omega| |t| or a heavy top's W |t|, that float64 still determines: the
+#: frequencies are rounded numbers, and a few ulp of them shift the phase by more than 0.1 rad beyond it
+MAX_PHASE = 2.0**48
 
 
 def describe_value(x) -> str:
@@ -153,3 +158,19 @@ def as_shape(shape, name: str = "shape") -> tuple[int, ...]:
         if k < 0:
             raise InvalidInputError(f"{name} entries must be >= 0, got {shape!r}")
     return tuple(int(k) for k in items)
+
+
+def scaled_norms(a: ArrayLike, axes: int | tuple[int, int] = -1) -> np.ndarray:
+    """Euclidean (Frobenius) norms over ``axes`` without overflow in the squares (inf only when the norm is).
+
+    Examples
+    --------
+    >>> round(float(scaled_norms([3e200, 4e200, 0.0])) / 1e200, 12)
+    5.0
+    """
+    a = np.abs(np.asarray(a, dtype=float))
+    top = np.max(a, axis=axes, keepdims=True)
+    safe = np.where(top > 0, top, 1.0)
+    return (
+        np.squeeze(safe, axis=axes) * np.sqrt(np.sum(np.square(a / safe), axis=axes)) * (np.squeeze(top, axis=axes) > 0)
+    )

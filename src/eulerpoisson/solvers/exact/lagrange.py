@@ -144,6 +144,7 @@ import numpy as np
 from ...errors import InvalidInputError
 from ...numerics.elliptic import ellipk, elliprf, elliprj, jacobi_sncndn
 from ...numerics.quaternion import CONJUGATE, qmul
+from ...util.validate import MAX_PHASE, scaled_norms
 
 __all__ = ["lagrange_top_motion", "check_top_ranges"]
 
@@ -673,10 +674,6 @@ def _per_time(c, tt):
     return cc, ss, cdot, sdot, rate_c, rate_s, perS, perD
 
 
-#: the largest phase ``W |t|`` at which float64 still determines the motion (the exact method's ``MAX_PHASE``)
-_MAX_PHASE = 2.0**48
-
-
 def check_top_ranges(A, mass, ell, g, omega0, t) -> None:
     r"""Refuse finite inputs of a Lagrange top whose gravity scale, frequency or phase leaves float64.
 
@@ -702,9 +699,7 @@ def check_top_ranges(A, mass, ell, g, omega0, t) -> None:
     omega0 = np.asarray(omega0, dtype=float)
     g = np.asarray(g, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
-        gmax = np.max(np.abs(g), axis=-1, initial=0.0)
-        gs = np.where(gmax > 0.0, gmax, 1.0)
-        P = mass * (gmax * np.sqrt(np.sum((g / gs[..., None]) ** 2, axis=-1))) * np.abs(ell)
+        P = mass * scaled_norms(g) * np.abs(ell)
     bad = ~np.isfinite(P)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
@@ -713,11 +708,7 @@ def check_top_ranges(A, mass, ell, g, omega0, t) -> None:
             "(the motion depends on mass * |g| * |ell| / A and omega0 only)"
         )
     with np.errstate(over="ignore", invalid="ignore"):
-        # |omega0|^2 scaled like |g| (no overflow of the squares for |omega0| below 1e308)
-        wmax = np.max(np.abs(omega0), axis=-1, initial=0.0)
-        ws = np.where(wmax > 0.0, wmax, 1.0)
-        w2 = wmax * wmax * np.sum((omega0 / ws[..., None]) ** 2, axis=-1)
-        W2 = P / A + w2
+        W2 = P / A + scaled_norms(omega0) ** 2
         tmax = float(np.max(np.abs(t), initial=0.0))
         phase = np.sqrt(W2) * tmax
     bad = ~np.isfinite(W2)
@@ -727,12 +718,12 @@ def check_top_ranges(A, mass, ell, g, omega0, t) -> None:
             f"the squared frequency mass |g| |ell| / A + |omega0|^2 overflows float64 (body {i} of the flattened "
             "batch): rescale the units of time"
         )
-    bad = ~(phase <= _MAX_PHASE)
+    bad = ~(phase <= MAX_PHASE)
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(
             f"W |t| = {np.ravel(phase)[i]:.3g} (body {i} of the flattened batch, W the top's frequency "
-            f"sqrt(mass |g| |ell| / A + |omega0|^2), |t| = {tmax:.6g}) exceeds 2^48 = {_MAX_PHASE:.3g} rad: "
+            f"sqrt(mass |g| |ell| / A + |omega0|^2), |t| = {tmax:.6g}) exceeds 2^48 = {MAX_PHASE:.3g} rad: "
             "float64 no longer determines the phase of the motion there"
         )
 
@@ -837,10 +828,7 @@ def lagrange_top_motion(A, C, mass, ell, g, q0, omega0, t, *, compiled=None):
     with np.errstate(over="ignore"):
         gn = np.linalg.norm(g_, axis=-1)
     if not np.all(np.isfinite(gn)):
-        # the plain norm overflows from |g| ~ 1e154 on: there scaled by the largest component
-        gmax = np.max(np.abs(g_), axis=-1, initial=0.0)
-        gs = np.where(gmax > 0.0, gmax, 1.0)
-        gn = np.where(np.isfinite(gn), gn, gmax * np.linalg.norm(g_ / gs[:, None], axis=-1))
+        gn = np.where(np.isfinite(gn), gn, scaled_norms(g_))  # the plain norm overflows from |g| ~ 1e154 on
     with np.errstate(over="ignore"):
         P = mass_ * gn * np.abs(ell_)
     check_top_ranges(A_, mass_, ell_, g_, om_, t)

@@ -41,6 +41,7 @@ from ...attitude.core import quaternion_from_rotation_matrix
 from ...errors import InvalidInputError
 from ...numerics.quaternion import qmul
 from ...util import jit
+from ...util.validate import MAX_PHASE
 from ..problem import Problem, compose_initial, left_composed
 from ..registry import Method, MethodOptions, MethodResult, overrides, register_method
 
@@ -48,7 +49,6 @@ __all__ = ["Exact"]
 
 
 #: largest |Omega| |t| the closed form accepts (2^48, about 2.8e14 radians)
-MAX_PHASE = 2.0**48
 
 
 def _check_phase_range(problem: Problem, speed=None) -> None:
@@ -94,7 +94,7 @@ def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
             return
         speed = np.sqrt(w2)
         if not np.all(np.isfinite(speed)):  # |Omega0| beyond 1e154: its square overflowed, not the rate
-            from ...model.torque_base import scaled_norms
+            from ...util.validate import scaled_norms
 
             speed = scaled_norms(w)
         what = "|omega0| |t|"

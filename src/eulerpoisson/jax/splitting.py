@@ -313,7 +313,9 @@ def integrate(
     Values are checked only when the inputs are concrete (an eager call). Under ``jit``, ``vmap``
     or ``grad`` (traced inputs) only the shapes are checked: a NaN or infinite input, a zero
     ``quaternion0`` or an inertia that is not positive definite then gives NaN outputs without an
-    error. The torque's parameters are not checked here.
+    error. Torques of :mod:`eulerpoisson.torques` whose parameters overflow float64 together are
+    refused (``eulerpoisson.model.torque_base.check_torque_scales``); the parameters of a torque
+    built in :mod:`eulerpoisson.jax.torques` are not checked.
 
     Notes
     -----

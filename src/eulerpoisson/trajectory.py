@@ -112,11 +112,18 @@ def stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
         and omega.dtype == _FLOAT64
         and quaternion.shape[1:] == (4,)
         and omega.shape[-1:] == (3,)
-        and math.isfinite(sum(quaternion.ravel().tolist()) + sum(omega.ravel().tolist()))
     ):
-        # a few samples whose values are all finite (an infinite or NaN one makes the sum so): the checks in
-        # plain floats (the sum, not each value, to spare Python calls)
-        return _unit_continuous(t, quaternion)
+        # a few samples: the checks in plain floats (the sum, not each value, to spare Python calls: an
+        # infinite or NaN value makes it so)
+        rows = quaternion.tolist()
+        if len(rows) == 1:  # one sample: stored as it is when of unit norm (finite then), as _unit_continuous does
+            w, x, y, z = rows[0]
+            if abs(math.sqrt(w * w + x * x + y * y + z * z) - 1.0) <= _UNIT_SLACK and math.isfinite(
+                sum(omega.ravel().tolist())
+            ):
+                return quaternion
+        if math.isfinite(sum(map(sum, rows)) + sum(omega.ravel().tolist())):
+            return _unit_continuous(t, quaternion)
     q = as_float_array(quaternion, "quaternion", (4,))
     as_float_array(omega, "omega", (3,))
     return _unit_continuous(t, q)
@@ -265,7 +272,8 @@ class Trajectory:
         """The trajectory that ``Trajectory(t, quaternion, omega, model.body, method, options, stats,
         torque=model.torques, _prepared=True)`` makes, without its checks (for the solve driver's quick lane,
         which has made every part as that call would: ``t`` a float64 array (T,), ``quaternion`` and ``omega``
-        returned by :func:`stored_attitudes` and checked by it, ``model`` of one free body)."""
+        returned by :func:`stored_attitudes` and checked by it, ``model`` of one free body, ``stats`` a dict of
+        its own: the trajectory keeps it)."""
         self = cls.__new__(cls)
         self.t = t
         self.omega = omega
@@ -274,7 +282,7 @@ class Trajectory:
         self.model = model
         self.method = method
         self.options = dict(options)
-        self.stats = dict(stats)
+        self.stats = stats  # (made for this trajectory by the caller)
         return self
 
     # ------------------------------------------------------------------

@@ -119,6 +119,12 @@ class Model:
     """
 
     def __init__(self, body: RigidBody | ArrayLike, torque: TorqueLike = None) -> None:
+        self.torques: tuple[Torque, ...]
+        if torque is None and type(body) is RigidBody:  # the free body (the common case, without the steps below)
+            self.body = body
+            self.torques = ()
+            self.batch_shape = body.batch_shape
+            return
         if isinstance(body, Model):
             raise TypeError("body is already a Model; pass its body and torques, or the Model itself to solve()")
         if not isinstance(body, RigidBody):
@@ -126,7 +132,7 @@ class Model:
                 raise TypeError(f"body must be a RigidBody or an inertia array, got {body!r}")
             body = RigidBody(body)
         self.body = body
-        self.torques: tuple[Torque, ...] = as_torques(torque)
+        self.torques = as_torques(torque)
         shapes = [body.batch_shape] + [tq.batch_shape for tq in self.torques]
         try:
             self.batch_shape = np.broadcast_shapes(*shapes) if self.torques else body.batch_shape

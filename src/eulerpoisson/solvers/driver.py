@@ -137,12 +137,23 @@ def solve(
     >>> tr.omega.shape
     (2, 3)
     """
+    quick = quick_solve(
+        body,
+        t,
+        omega0=omega0,
+        m0=m0,
+        attitude0=attitude0,
+        gibbs0=gibbs0,
+        torque=torque,
+        method=method,
+        workers=workers,
+        **options,
+    )
+    if quick is not None:  # one free body at a few times: the same result without the general set-up
+        return quick
     args: dict[str, Any] = dict(
         omega0=omega0, m0=m0, attitude0=attitude0, gibbs0=gibbs0, torque=torque, method=method, workers=workers
     )
-    quick = quick_solve(body, t, **args, **options)
-    if quick is not None:  # one free body at a few times: the same result without the general set-up
-        return quick
     # a tuple is a list of times here (not solve_to_file's grid)
     run = prepare_run(body, list(t) if isinstance(t, tuple) else t, in_memory=True, stacklevel=3, **args, **options)
     return collect(run)

@@ -101,6 +101,7 @@ import numpy as np
 from ..errors import InvalidInputError
 from ..model.equations import Model
 from ..trajectory import stored_attitudes
+from ..util.env import env_value
 from .problem import Problem
 from .registry import Method, MethodResult
 
@@ -184,7 +185,7 @@ def resolve_workers(workers: object = None) -> int:
     n = check_workers(workers)
     if n is not None:
         return available_cores() if n == -1 else n
-    env = os.environ.get(ENV_WORKERS, "").strip()
+    env = (env_value(ENV_WORKERS) or "").strip()
     if env:
         try:
             value = int(env)

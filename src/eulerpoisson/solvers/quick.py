@@ -13,8 +13,9 @@ and does only what it needs:
   no ``m0``/``gibbs0``/``workers``;
 * at most :data:`QUICK_MAX_TIMES` finite output times;
 * the method by name (or None: the default for the free body, ``exact``),
-  with options of plain values (their checked configuration is kept in a
-  small cache).
+  with options of plain values (the configured method, and its support of
+  a body given by its moments, are checked once per kind of call and kept
+  in a small cache, :class:`_Plan`).
 
 It then calls the method's shortcut for one body (:meth:`~.Method.run_one`:
 the exact method and taylor have one, which skip the problem and its
@@ -30,7 +31,6 @@ then solves it or raises its error.
 from __future__ import annotations
 
 import math
-import os
 import time as _time
 from typing import TYPE_CHECKING, Any
 
@@ -40,6 +40,7 @@ from ..errors import InvalidInputError
 from ..model.body import RigidBody, cached_body
 from ..model.equations import Model
 from ..trajectory import Trajectory, stored_attitudes
+from ..util.env import env_value
 from ..util.jit import run_shape, whole_run
 from . import engine
 from .parallel import ENV_WORKERS, resolve_workers, solve_batch
@@ -54,12 +55,31 @@ __all__ = ["QUICK_MAX_TIMES", "quick_solve"]
 #: most output times a call takes through the quick lane
 QUICK_MAX_TIMES = 64
 
-#: configured methods by (name, options): the checked options of the calls seen (bounded)
-_CONFIGURED: dict[tuple, Method] = {}
-_CONFIGURED_MAX = 64
+#: what the lane keeps of the calls seen, by (method name, plain options, moments or None): :class:`_Plan` (bounded)
+_PLANS: dict[tuple, _Plan] = {}
+_PLANS_MAX = 64
 
 _FLOAT64 = np.dtype(np.float64)
 _IDENTITY = (1.0, 0.0, 0.0, 0.0)
+
+
+class _Plan:
+    """The checked part of a kind of call: the configured method (for a body given by its three moments, the
+    method's support of that body checked too)."""
+
+    __slots__ = ("cls", "method", "name")
+
+    def __init__(self, name: str, method: Method):
+        self.name = name
+        self.method = method
+        self.cls = type(method)
+
+    def current(self) -> bool:
+        """Whether the name still stands for the method's class (a plug-in may register another since)."""
+        try:
+            return get_method(self.name) is self.cls
+        except InvalidInputError:
+            return False  # unregistered since: the general path raises
 
 
 def _number(x: Any) -> float | None:
@@ -84,6 +104,11 @@ def _floats(x: Any, n: int | None) -> list[float] | None:
         return None
     out = []
     for v in seq:
+        if type(v) is float:  # (the common case, without a call)
+            if v - v != 0.0:  # inf or NaN
+                return None
+            out.append(v)
+            continue
         f = _number(v)
         if f is None:
             return None
@@ -91,46 +116,32 @@ def _floats(x: Any, n: int | None) -> list[float] | None:
     return out
 
 
-def _configured(name: str, options: dict[str, Any]) -> Method | None:
-    """The configured method (cached by its plain option values), or None where the general path must decide."""
-    key_items = []
+def _options_key(options: dict[str, Any]) -> tuple | None:
+    """The options as a key of plain values (sorted by name), or None where one is not plain (the general path)."""
+    if not options:
+        return ()
+    items = []
     for k, v in options.items():
         if v is not None and type(v) not in (bool, int, float, str):
             return None
-        key_items.append((k, type(v).__name__, v))
-    key = (name, tuple(sorted(key_items)))
-    m = _CONFIGURED.get(key)
-    if m is not None:
-        try:
-            registered = get_method(name)
-        except InvalidInputError:
-            registered = None  # unregistered since (a plug-in): the general path raises
-        if type(m) is not registered:
-            _CONFIGURED.pop(key, None)
-            m = None
-    if m is None:
-        try:
-            _, m = engine.configure_method(name, dict(options))
-        except (TypeError, InvalidInputError):
-            return None  # the general path raises it
-        if m is None:  # pragma: no cover - a name is given
-            return None
-        if len(_CONFIGURED) >= _CONFIGURED_MAX:
-            _CONFIGURED.clear()
-        _CONFIGURED[key] = m
-    return m
+        items.append((k, type(v).__name__, v))
+    return tuple(sorted(items))
 
 
-def _body(body: Any) -> RigidBody | None:
-    if type(body) is RigidBody:
-        return body if body.batch_shape == () else None
-    moments = _floats(body, 3)
-    if moments is None:
-        return None
+def _make_plan(name: str, options: dict[str, Any], moments: tuple[float, float, float] | None) -> _Plan | None:
+    """The plan of a kind of call (configured and checked once), or None where the general path must decide."""
     try:
-        return cached_body((moments[0], moments[1], moments[2]))
-    except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
+        _, m = engine.configure_method(name, dict(options))
+    except (TypeError, InvalidInputError):
         return None  # the general path raises it
+    if m is None:  # pragma: no cover - a name is given
+        return None
+    if moments is not None:
+        try:
+            check_supported(m, Model(cached_body(moments)))  # the configured method: its options count
+        except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
+            return None  # the general path raises it
+    return _Plan(name, m)
 
 
 def quick_solve(
@@ -180,10 +191,28 @@ def quick_solve(
     w = _floats(omega0, 3)
     if times is None or w is None:
         return None
-    m = _configured(name, options)
-    b = _body(body)
-    if m is None or b is None:
+    if type(body) is RigidBody:
+        if body.batch_shape != ():
+            return None
+        moments = None
+    else:
+        mo = _floats(body, 3)
+        if mo is None:
+            return None
+        moments = (mo[0], mo[1], mo[2])
+    okey = _options_key(options)
+    if okey is None:
         return None
+    key = (name, okey, moments)
+    plan = _PLANS.get(key)
+    if plan is None or not plan.current():
+        plan = _make_plan(name, options, moments)
+        if plan is None:
+            return None
+        if len(_PLANS) >= _PLANS_MAX:
+            _PLANS.clear()
+        _PLANS[key] = plan
+    m, cls = plan.method, plan.cls
     if attitude0 is None:
         q0 = np.array(_IDENTITY)
     else:
@@ -193,15 +222,19 @@ def quick_solve(
             q0 = initial_quaternion(attitude0, None).copy()
         except (TypeError, InvalidInputError):
             return None
-    model = Model(b)
-    cls = type(m)
-    try:
-        check_supported(m, model)  # the configured method: its options count (a free-body-only scheme)
-    except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
-        return None
-    tt = np.array(times)
+    if moments is None:
+        b = body
+        model = Model(b)
+        try:
+            check_supported(m, model)  # the configured method: its options count (a free-body-only scheme)
+        except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
+            return None
+    else:
+        b = cached_body(moments)  # (checked once per distinct moments; arrays of its own)
+        model = Model(b)
     if not cls.negative_times and min(times) < 0:
         return None
+    tt = np.array(times)
     wa = np.array(w)
     if cls.order is not None:
         # a stepping method's long run is cut into segments (engine.plan_segments): the general path
@@ -209,15 +242,17 @@ def quick_solve(
         turns = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * max(abs(v) for v in times)
         if not (math.isfinite(turns) and turns <= engine.SEGMENT_TURNS):
             return None
-    if os.environ.get(ENV_WORKERS):  # (a bad setting is an error for one body too: the general path raises it)
+    if env_value(ENV_WORKERS):  # (a bad setting is an error for one body too: the general path raises it)
         try:
             resolve_workers(None)
         except (TypeError, ValueError):
             return None
     n = len(times)
-    with whole_run(*run_shape(0, n)):
-        res = m.run_one(b, q0, wa, tt)  # the method's shortcut for one body, when it has one
-        if res is None:
+    # the method's shortcut for one body, when it has one (the problem is the whole run: whole_run's sizes are
+    # those a method's run_one reads already)
+    res = m.run_one(b, q0, wa, tt)
+    if res is None:
+        with whole_run(*run_shape(0, n)):
             problem = Problem(model=model, q0=q0, omega0=wa, t=tt)
             m = m.for_batch(problem)
             res = solve_batch(m, problem, None)

@@ -269,7 +269,10 @@ class Method:
         ``solve_batch(self.for_batch(problem), problem)`` returns for that
         problem, bit for bit and stats included (``"threads": 1``), without
         building the problem; None (the default) where it has no such
-        shortcut: the quick lane then takes that general route.
+        shortcut: the quick lane then takes that general route. The lane
+        calls it with the problem as the whole run (no
+        :class:`~eulerpoisson.util.jit.whole_run` of its own: one body at
+        ``T`` times is the run's size, and an enclosing one stays in force).
         """
         return None
 

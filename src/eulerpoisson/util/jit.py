@@ -34,6 +34,8 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from .env import env_value
+
 __all__ = [
     "USE_NUMBA",
     "NUMPY_BELOW",
@@ -85,7 +87,7 @@ def numpy_below() -> float:
     InvalidInputError
         The environment variable is not a number >= 0.
     """
-    env = os.environ.get(ENV_NUMPY_BELOW, "").strip()
+    env = (env_value(ENV_NUMPY_BELOW) or "").strip()
     if not env:
         return NUMPY_BELOW
     try:

@@ -77,14 +77,10 @@ def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
     if t.size == 0:
         return
     few = w.ndim == 1 and t.size <= 16  # one body at a few times: the maxima in plain floats
-    tmax = max(abs(x) for x in t.tolist()) if few else float(np.abs(t).max())
+    tmax = max(map(abs, t.tolist())) if few else float(np.abs(t).max())
     if speed is None:
         # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
-        wmax = (
-            max(abs(x) for x in w.tolist())
-            if few
-            else max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
-        )
+        wmax = max(map(abs, w.tolist())) if few else max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
         if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
             return
         with np.errstate(over="ignore"):
@@ -222,7 +218,7 @@ class Exact(Method):
     def run_one(self, body, q0, omega0, t) -> MethodResult | None:
         """One free body whose principal frame is the body frame (the quick lane, :meth:`Method.run_one`):
         what :meth:`run` computes for it, without the problem."""
-        if not _all_identity(body.principal_axes) or overrides(self, Exact, _RUN_HOOKS):
+        if (type(self) is not Exact and overrides(self, Exact, _RUN_HOOKS)) or not _all_identity(body.principal_axes):
             return None  # (a subclass that decides or runs otherwise: the general route, through its own methods)
         T = t.shape[0]
         path = self._path if self._path is not None else _one_body_path(T)
@@ -357,9 +353,25 @@ _COMPILED_ARG = {"compiled": True, "numpy": False}
 
 
 def _one_body_path(n_times: int) -> str:
-    """:meth:`Exact._free_path` of one body at ``n_times`` times (the whole run's size decides)."""
-    B, T = jit.run_shape(1, n_times)
-    return _free_path_from(_numpy_cost(B, T, True), _python_cost(B, T))
+    """:meth:`Exact._free_path` of one body at ``n_times`` times (the whole run's size decides).
+
+    The same choice as :func:`_free_path_from` on the estimated costs, remembered by the run's shape, the
+    threshold in force (:func:`~eulerpoisson.util.jit.numpy_below`) and whether numba is active.
+    """
+    shape = jit.run_shape(1, n_times)
+    key = (shape, jit.numpy_below(), jit.numba_active())
+    path = _ONE_BODY_PATHS.get(key)
+    if path is None:
+        B, T = shape
+        path = _free_path_from(_numpy_cost(B, T, True), _python_cost(B, T))
+        if len(_ONE_BODY_PATHS) >= 256:
+            _ONE_BODY_PATHS.clear()
+        _ONE_BODY_PATHS[key] = path
+    return path
+
+
+#: :func:`_one_body_path`'s choices by (run shape, threshold, numba active)
+_ONE_BODY_PATHS: dict[tuple, str] = {}
 
 
 def _free_path_from(numpy_seconds: float, python_seconds: float) -> str:

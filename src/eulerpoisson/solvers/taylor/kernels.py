@@ -1250,11 +1250,12 @@ def integrate_numba(moments, w0, qref0, t, *, tol, order, dt, max_steps, thresho
     Runs the plain-Python version of the same code when numba is not used
     (slow; :func:`integrate_numpy` is the fallback actually used then).
     """
-    moments, w0, qref0, t = (kernel_array(x) for x in (moments, w0, qref0, t))  # (one signature per kernel)
+    # (one signature per kernel)
+    moments, w0, qref0, t = kernel_array(moments), kernel_array(w0), kernel_array(qref0), kernel_array(t)
     B, T = moments.shape[0], t.shape[0]
     if T == 1:  # one output time: the orderings below without the sorting
         one, none = np.zeros(1, dtype=np.int64), np.zeros(0, dtype=np.int64)
-        pos, neg = (one, none) if t[0] >= 0 else (none, one)
+        pos, neg = (one, none) if t.item() >= 0 else (none, one)
     else:
         pos = np.flatnonzero(t >= 0)
         pos = np.ascontiguousarray(pos[np.argsort(t[pos], kind="stable")], dtype=np.int64)

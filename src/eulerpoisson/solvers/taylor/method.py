@@ -707,24 +707,22 @@ class Taylor(Method):
 
     def _integrate(self, moments, w0, q0, t, lanes):
         """The float64 free-body integration of :meth:`run` in the principal frame: ``(q, omega, stats)``."""
-        c = self.config
         # the options were checked with the method, the arrays with the problem (integrate_principal's checks)
-        dt = c["dt"]
-        tol = float(c["tol"])
-        order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
-        return _integrate_checked(
-            moments,
-            w0,
-            q0,
-            t,
-            tol,
-            int(order),
-            None if dt is None else float(dt),
-            int(c["max_steps"]),
-            float(c["chart_threshold"]),
-            bool(_k.USE_NUMBA),
-            lanes,
-        )
+        kopts = self.__dict__.get("_kernel_options")
+        if kopts is None:  # (normalized once per configured method: a method's options do not change)
+            c = self.config
+            dt = c["dt"]
+            tol = float(c["tol"])
+            order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
+            kopts = self._kernel_options = (
+                tol,
+                int(order),
+                None if dt is None else float(dt),
+                int(c["max_steps"]),
+                float(c["chart_threshold"]),
+            )
+        tol, order, dt, max_steps, threshold = kopts
+        return _integrate_checked(moments, w0, q0, t, tol, order, dt, max_steps, threshold, bool(_k.USE_NUMBA), lanes)
 
     def run(self, problem: Problem) -> MethodResult:
         if not problem.model.is_free:

@@ -348,6 +348,151 @@ def _coefficients_top(order, Q, W, V, MI, I, Iinv, ML, tau0):
         Q[k + 1, 3] = s3 * hinv
 
 
+def _coefficients_top_principal(order, Q, W, V, E, ML, tau0i):
+    r""":func:`_coefficients_top` in a principal frame of the body (a diagonal inertia tensor).
+
+    :math:`I^{-1}\big((I\boldsymbol\Omega)\times\boldsymbol\Omega\big)_a = e_a\,\Omega_b\Omega_c` with
+    :math:`e_a = (I_b - I_c)/I_a`, :math:`(a, b, c)` cyclic: the angular-velocity equation takes three
+    Cauchy products of the rows of W (``E`` the three :math:`e_a`) instead of the six of
+    :math:`(I\boldsymbol\Omega)\times\boldsymbol\Omega` with the matrix products around them, 21 fused
+    operations per term instead of 24 (the free body's kernel has 15). ``tau0i`` is
+    :math:`I^{-1}\boldsymbol\tau_0`, ``ML`` :math:`I^{-1}L`. Row 0 of Q, W and V is set.
+    """
+    e0 = E[0]
+    e1 = E[1]
+    e2 = E[2]
+    for k in range(order):
+        # the term j = 0 starts the sums: row 0 of the left factors with the newest row k of W
+        w0 = W[k, 0]
+        w1 = W[k, 1]
+        w2 = W[k, 2]
+        u0 = W[0, 0]
+        u1 = W[0, 1]
+        u2 = W[0, 2]
+        p0 = u1 * w2
+        p1 = u2 * w0
+        p2 = u0 * w1
+        v0 = V[0, 0]
+        v1 = V[0, 1]
+        v2 = V[0, 2]
+        c0 = v1 * w2
+        c0 -= v2 * w1
+        c1 = v2 * w0
+        c1 -= v0 * w2
+        c2 = v0 * w1
+        c2 -= v1 * w0
+        pw = Q[0, 0]
+        px = Q[0, 1]
+        py = Q[0, 2]
+        pz = Q[0, 3]
+        s0 = -px * w0
+        r0 = -py * w1
+        r0 -= pz * w2
+        s1 = pw * w0
+        r1 = py * w2
+        r1 -= pz * w1
+        s2 = pw * w1
+        r2 = pz * w0
+        r2 -= px * w2
+        s3 = pw * w2
+        r3 = px * w1
+        r3 -= py * w0
+        if k > 0:
+            for j in range(1, k):
+                m = k - j
+                w0 = W[m, 0]
+                w1 = W[m, 1]
+                w2 = W[m, 2]
+                u0 = W[j, 0]
+                u1 = W[j, 1]
+                u2 = W[j, 2]
+                p0 += u1 * w2
+                p1 += u2 * w0
+                p2 += u0 * w1
+                v0 = V[j, 0]
+                v1 = V[j, 1]
+                v2 = V[j, 2]
+                c0 += v1 * w2
+                c0 -= v2 * w1
+                c1 += v2 * w0
+                c1 -= v0 * w2
+                c2 += v0 * w1
+                c2 -= v1 * w0
+                pw = Q[j, 0]
+                px = Q[j, 1]
+                py = Q[j, 2]
+                pz = Q[j, 3]
+                s0 -= px * w0
+                r0 -= py * w1
+                r0 -= pz * w2
+                s1 += pw * w0
+                r1 += py * w2
+                r1 -= pz * w1
+                s2 += pw * w1
+                r2 += pz * w0
+                r2 -= px * w2
+                s3 += pw * w2
+                r3 += px * w1
+                r3 -= py * w0
+            # the term j = k (the newest rows of W, v and q with row 0 of W) last
+            w0 = W[0, 0]
+            w1 = W[0, 1]
+            w2 = W[0, 2]
+            u0 = W[k, 0]
+            u1 = W[k, 1]
+            u2 = W[k, 2]
+            p0 += u1 * w2
+            p1 += u2 * w0
+            p2 += u0 * w1
+            v0 = V[k, 0]
+            v1 = V[k, 1]
+            v2 = V[k, 2]
+            c0 += v1 * w2
+            c0 -= v2 * w1
+            c1 += v2 * w0
+            c1 -= v0 * w2
+            c2 += v0 * w1
+            c2 -= v1 * w0
+            pw = Q[k, 0]
+            px = Q[k, 1]
+            py = Q[k, 2]
+            pz = Q[k, 3]
+            s0 -= px * w0
+            r0 -= py * w1
+            r0 -= pz * w2
+            s1 += pw * w0
+            r1 += py * w2
+            r1 -= pz * w1
+            s2 += pw * w1
+            r2 += pz * w0
+            r2 -= px * w2
+            s3 += pw * w2
+            r3 += px * w1
+            r3 -= py * w0
+        inv = 1.0 / (k + 1)
+        v0 = V[k, 0]
+        v1 = V[k, 1]
+        v2 = V[k, 2]
+        f0 = e0 * p0 + (ML[0, 0] * v0 + ML[0, 1] * v1 + ML[0, 2] * v2)
+        f1 = e1 * p1 + (ML[1, 0] * v0 + ML[1, 1] * v1 + ML[1, 2] * v2)
+        f2 = e2 * p2 + (ML[2, 0] * v0 + ML[2, 1] * v1 + ML[2, 2] * v2)
+        if k == 0:
+            f0 += tau0i[0]
+            f1 += tau0i[1]
+            f2 += tau0i[2]
+        W[k + 1, 0] = f0 * inv
+        W[k + 1, 1] = f1 * inv
+        W[k + 1, 2] = f2 * inv
+        V[k + 1, 0] = c0 * inv
+        V[k + 1, 1] = c1 * inv
+        V[k + 1, 2] = c2 * inv
+        hinv = 0.5 * inv
+        Q[k + 1, 0] = (s0 + r0) * hinv
+        Q[k + 1, 1] = (s1 + r1) * hinv
+        Q[k + 1, 2] = (s2 + r2) * hinv
+        Q[k + 1, 3] = (s3 + r3) * hinv
+
+
 def _norm_inf(X, k, n):
     m = 0.0
     for a in range(n):
@@ -392,7 +537,8 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
     Returns ``(steps, status)``: status 0 ok, 1 ``max_steps`` exhausted, 2 non-finite state.
 
     One Poisson vector and no orbit term (gravity, or a space torque, with or without a constant
-    body torque) take :func:`_coefficients_top`.
+    body torque) take :func:`_coefficients_top`, or :func:`_coefficients_top_principal` when the
+    tensor is diagonal (the method integrates a top in its principal frame).
     """
     nv = S.shape[0]
     orbit = kappa != 0.0
@@ -423,12 +569,23 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
         j += 1
     if j >= T:
         return 0, 0
-    # the specialized kernel: ML = I^-1 L
+    # the specialized kernels: ML = I^-1 L; in a principal frame (a diagonal tensor) the Euler
+    # coefficients E and I^-1 tau0
     ML = np.zeros((3, 3))
+    E = np.zeros(3)
+    tau0i = np.zeros(3)
+    principal = I[0, 1] == 0.0 and I[0, 2] == 0.0 and I[1, 0] == 0.0 and I[1, 2] == 0.0
+    principal = principal and I[2, 0] == 0.0 and I[2, 1] == 0.0
     if top:
         for a in range(3):
             for c in range(3):
                 ML[a, c] = Iinv[a, 0] * L[0, 0, c] + Iinv[a, 1] * L[0, 1, c] + Iinv[a, 2] * L[0, 2, c]
+        if principal:
+            E[0] = (I[1, 1] - I[2, 2]) / I[0, 0]
+            E[1] = (I[2, 2] - I[0, 0]) / I[1, 1]
+            E[2] = (I[0, 0] - I[1, 1]) / I[2, 2]
+            for a in range(3):
+                tau0i[a] = tau0[a] / I[a, a]
     sgn = 1.0 if times[T - 1] > 0 else -1.0
     safety = math.exp(-0.7 / (order - 1)) if order > 1 else 0.5
     steps = 0
@@ -465,7 +622,9 @@ def integrate_body(q0, w0, I, Iinv, tau0, S, L, nu, kappa, times, tol, order, dt
             Rr[0, 0] = a0
             Rr[0, 1] = a1
             Rr[0, 2] = a2
-        if top:
+        if top and principal:
+            _coefficients_top_principal(order, Q, W, Vt, E, ML, tau0i)
+        elif top:
             _coefficients_top(order, Q, W, Vt, MI, I, Iinv, ML, tau0)
         else:
             _coefficients(order, Q, W, V, Z, Rr, MI, I, Iinv, tau0, L, nv, nu, kappa, orbit)
@@ -544,6 +703,7 @@ if USE_NUMBA:  # pragma: no branch
     # contraction leaves exact); the interpreted twin agrees to round-off, not bit for bit
     _coefficients = _njit(cache=True, nogil=True, fastmath={"contract"})(_coefficients)
     _coefficients_top = _njit(cache=True, nogil=True, fastmath={"contract"})(_coefficients_top)
+    _coefficients_top_principal = _njit(cache=True, nogil=True, fastmath={"contract"})(_coefficients_top_principal)
     _norm_inf = _njit(cache=True, nogil=True)(_norm_inf)
     _horner = _njit(cache=True, nogil=True, fastmath={"contract"})(_horner)
     integrate_body = _njit(cache=True, nogil=True, fastmath={"contract"})(integrate_body)

@@ -280,3 +280,31 @@ def test_exact_motion_refuses_an_unknown_path():
 def test_python_twins_reports_whether_the_twins_run():
     with jit.python_twins() as twins:
         assert twins is (not jit.numba_active())
+
+
+def test_the_twins_call_each_other_directly():
+    """Within python_twins a kernel's twin runs in a copy of its module's namespace whose lazy kernels are their
+    direct twins and whose lazy intrinsics their Python twins (no LazyDispatcher call per helper; an intrinsic
+    of compiled code only stays); a function writing a module global is left as it is."""
+    code = """
+import json
+import numpy as np
+from eulerpoisson.util import jit
+from eulerpoisson.solvers.exact import kernels as K, motion
+
+M, q = motion.exact_motion([1.0, 2.0, 3.0], [1.0, 0.2, 1.5], [0.0, 2.0], compiled="python")
+twin = K.motion_kernel_scalar._twin
+lazy = sorted(
+    k for k, v in twin.__globals__.items()
+    if isinstance(v, jit.LazyDispatcher) or (isinstance(v, jit.LazyIntrinsic) and v.python is not None)
+)
+print(json.dumps({"direct": twin is not K.motion_kernel_scalar.python, "lazy": lazy,
+                  "module_untouched": isinstance(K.body_eval, jit.LazyDispatcher),
+                  "writer_kept": jit._direct_twin(motion._kernels) is motion._kernels}))
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=HANG_GUARD_S)
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    if not jit.USE_NUMBA:  # (no lazy kernels: plain functions throughout)
+        return
+    assert out == {"direct": True, "lazy": [], "module_untouched": True, "writer_kept": True}

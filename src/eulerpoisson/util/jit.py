@@ -25,11 +25,13 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import dis
 import functools
 import importlib.util
 import os
 import sys
 import threading
+import types
 from collections.abc import Iterator
 
 import numpy as np
@@ -302,8 +304,14 @@ class LazyDispatcher(_Lazy):
 
     def __call__(self, *args, **kwargs):
         if not _ACTIVE and _TWINS.get():
-            return self.python(*args, **kwargs)
+            twin = self._twin
+            if twin is None:
+                twin = self._twin = _direct_twin(self.python)
+            return twin(*args, **kwargs)
         return self.real(*args, **kwargs)
+
+    #: :attr:`python` with its calls of other kernels made directly (:func:`_direct_twin`), made on first use
+    _twin = None
 
     def __getattr__(self, name):
         if name.startswith("__"):
@@ -339,6 +347,61 @@ class LazyIntrinsic(_Lazy):
 
     def __repr__(self):
         return f"<lazy numba intrinsic {self.defn.__qualname__}>"
+
+
+# the plain-Python twins, calling each other directly -------------------------------------------------------
+#: by id of a module's namespace: (the namespace, its copy in which the lazy kernels are their direct twins)
+_TWIN_NAMESPACES: dict[int, tuple[dict, dict]] = {}
+#: by id of a function: (the function, its direct twin)
+_TWIN_FUNCTIONS: dict[int, tuple[types.FunctionType, types.FunctionType]] = {}
+_GLOBAL_WRITES = frozenset({"STORE_GLOBAL", "DELETE_GLOBAL"})
+
+
+def _direct_twin(f):
+    """``f`` (a kernel's plain-Python twin) as a function whose calls of other kernels are direct.
+
+    Within :func:`python_twins` every call of a lazy kernel from a twin went
+    through :meth:`LazyDispatcher.__call__` (a Python-level call and a context
+    lookup, about a microsecond: some hundreds of them per evaluation of the
+    closed form, most of its time). The direct twin is ``f``'s code with a
+    copy of its module's namespace in which the lazy kernels are their direct
+    twins and the lazy intrinsics their Python twins, and the package's plain
+    functions (the jitable helpers) direct twins too: the same operations in
+    the same order, so the same numbers, about 1.5 times faster. The copy is
+    made once, when the twins first run; a function that writes a module
+    global, or is not a plain function of the package, is left as it is.
+    """
+    if type(f) is not types.FunctionType or not f.__module__.startswith("eulerpoisson"):
+        return f
+    entry = _TWIN_FUNCTIONS.get(id(f))
+    if entry is not None:
+        return entry[1]
+    if any(ins.opname in _GLOBAL_WRITES for ins in dis.get_instructions(f)):
+        twin = f
+    else:
+        twin = types.FunctionType(f.__code__, _twin_namespace(f.__globals__), f.__name__, f.__defaults__, f.__closure__)
+        twin.__kwdefaults__ = f.__kwdefaults__
+        twin.__qualname__ = f.__qualname__
+    _TWIN_FUNCTIONS[id(f)] = (f, twin)
+    return twin
+
+
+def _twin_namespace(namespace: dict) -> dict:
+    """The copy of a module's namespace that direct twins run in (see :func:`_direct_twin`)."""
+    entry = _TWIN_NAMESPACES.get(id(namespace))
+    if entry is not None:
+        return entry[1]
+    copy = dict(namespace)
+    _TWIN_NAMESPACES[id(namespace)] = (namespace, copy)  # (before the values: kernels of one module call each other)
+    for key, value in namespace.items():
+        if isinstance(value, LazyDispatcher):
+            copy[key] = _direct_twin(value.python)
+        elif isinstance(value, LazyIntrinsic):
+            if value.python is not None:
+                copy[key] = value.python
+        elif type(value) is types.FunctionType and value.__module__.startswith("eulerpoisson"):
+            copy[key] = _direct_twin(value)
+    return copy
 
 
 def lazy_njit(func=None, /, *, python=None, **options):

@@ -459,8 +459,13 @@ class Trajectory:
     def to_netcdf(self, path: str | os.PathLike[str]) -> None:
         """Write the trajectory to a NetCDF-4 file, atomically: :func:`eulerpoisson.io.netcdf.write_netcdf`.
 
+        An existing NetCDF file is replaced; any other file (a configuration, data: recognized by its content),
+        a folder or a store is not.
+
         Raises
         ------
+        OutputError
+            ``path`` holds something that is not a NetCDF file.
         MissingDependencyError
             If h5netcdf is missing (extra ``io``).
         OSError

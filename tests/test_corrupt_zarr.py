@@ -102,13 +102,20 @@ def test_corrupt_inertia_names_the_variable(store, tmp_path):
 
 
 def test_other_damage_keeps_its_own_message(store, tmp_path):
-    """Narrow: a missing chunk file is the fill value (an unfinished run), not a corrupt chunk."""
+    """Narrow: a missing chunk file is the fill value, not a corrupt chunk; in a finished store (not an unfinished
+    run's work folder) it is data lost, not a run to resume."""
     bad = _copy(store, tmp_path)
     (bad / "omega" / "c" / "3" / "0").unlink()
     lazy = LazyTrajectory(bad)
-    with pytest.raises(EulerPoissonError, match=r"samples 0:95 are not all written \(NaN\)") as info:
+    with pytest.raises(EulerPoissonError, match=r"samples 0:95 are missing \(NaN\) in a finished store") as info:
         lazy.load()
-    assert "corrupt" not in str(info.value)
+    assert "corrupt" not in str(info.value) and "resume" not in str(info.value)
+    with pytest.raises(EulerPoissonError, match=r"samples 0:95 of omega are missing \(NaN\) in a finished store"):
+        lazy.read_arrays(["omega"])
+    partial = tmp_path / ".run.zarr.partial"  # an unfinished run's work folder: resume it
+    bad.rename(partial)
+    with pytest.raises(EulerPoissonError, match=r"not all written yet \(NaN\): the run is unfinished; resume it"):
+        LazyTrajectory(partial).load()
 
 
 def test_intact_store_reads_as_before(store):

@@ -115,7 +115,7 @@ def test_opening_a_store_reads_only_metadata_and_ends(files, tmp_path, monkeypat
     out = capsys.readouterr().out
     assert "95, t from 0 to 20" in out and "Zarr store" in out and "drift" in out
     assert all(b - a == 1 for a, b in calls), calls
-    with pytest.raises(EulerPoissonError, match="not all written"):
+    with pytest.raises(EulerPoissonError, match="missing \\(NaN\\) in a finished store"):
         lz.load()
 
 

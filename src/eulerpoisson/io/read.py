@@ -682,11 +682,21 @@ class LazyTrajectory:
         w = self.omega.read(a, b, step)
         self._check_unit(q, f"samples {a}:{b}")
         if not (np.all(np.isfinite(t)) and np.all(np.isfinite(q)) and np.all(np.isfinite(w))):
-            raise EulerPoissonError(
-                f"{self.path}: samples {a}:{b} are not all written (NaN): an unfinished run? "
-                "resume it with the same 'simulate' command"
-            )
+            raise EulerPoissonError(self._unwritten(f"samples {a}:{b}"))
         return Trajectory(t, q, w, self.body, self.method, self.options, self.stats, torque=list(self.model.torques))
+
+    def _unwritten(self, what: str) -> str:
+        """The message for samples that read as NaN: an unfinished run's work folder (``.NAME.partial``: resume
+        it), or a finished store that lost data (a chunk file deleted: write it again)."""
+        if self.path.name.startswith(".") and self.path.name.endswith(".partial"):
+            return (
+                f"{self.path}: {what} are not all written yet (NaN): the run is unfinished; resume it with the "
+                f"command that wrote it ('simulate' again, or solve_to_file(..., resume=True))"
+            )
+        return (
+            f"{self.path}: {what} are missing (NaN) in a finished store: chunk files deleted or lost? "
+            f"write it again (the command that wrote it, with --overwrite)"
+        )
 
     def read_arrays(
         self, names: Iterable[str], a: int = 0, b: int | None = None, step: int = 1, *, scratch: dict | None = None
@@ -717,10 +727,7 @@ class LazyTrajectory:
             if nm == "quaternion":
                 self._check_unit(x, f"samples {a}:{b}")
             if nm != "gibbs" and not _all_finite(x):
-                raise EulerPoissonError(
-                    f"{self.path}: samples {a}:{b} of {nm} are not all written (NaN): an unfinished run? "
-                    "resume it with the same 'simulate' command"
-                )
+                raise EulerPoissonError(self._unwritten(f"samples {a}:{b} of {nm}"))
             out[nm] = x
         return out
 

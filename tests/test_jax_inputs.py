@@ -137,3 +137,26 @@ def test_integrate_refuses_torque_parameters_that_overflow_together():
         integrate([1.0, 1.0, 0.5], [1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0], 0.5, 10, top)
     with pytest.raises(InvalidInputError, match="torque GravityGradient overflows float64"):
         integrate([1.0, 1.0, 0.5], [1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0], 0.5, 10, [ep.torques.GravityGradient(1e200)])
+
+
+def test_integrate_refuses_jax_torques_that_are_not_finite():
+    """Torques built in eulerpoisson.jax.torques: a non-finite parameter, or parameters that overflow together
+    (an infinite torque at the initial state), are errors with concrete values; traced ones are not checked."""
+    from eulerpoisson.jax import torques as jt
+
+    args = ([1.0, 1.0, 0.5], [1.0, 0.0, 0.0, 0.0], [0.0, 0.2, 20.0], 0.5, 4)
+    with pytest.raises(InvalidInputError, match="torque Gravity: its value at the initial state is not finite"):
+        integrate(*args, jt.Gravity(1e300, [0.0, 0.3, 1e300]), order=2)
+    with pytest.raises(InvalidInputError, match="torque Gravity: a parameter is not finite"):
+        integrate(*args, jt.Gravity(np.nan, [0.0, 0.0, 0.1]), order=2)
+    overflowing_sum = jt.BodyTorque([1e308, 0.0, 0.0]) + jt.BodyTorque([1e308, 0.0, 0.0])
+    with pytest.raises(InvalidInputError, match="torque TorqueSum: its value at the initial state is not finite"):
+        integrate(*args, overflowing_sum, order=2)
+    t, q, w = integrate(*args, jt.Gravity(1.0, [0.0, 0.0, 0.1]), order=2)
+    assert np.isfinite(np.asarray(w)).all() and np.isfinite(np.asarray(q)).all()
+
+    def last_rate(mass):  # traced parameters: not checked (shapes only)
+        return integrate(*args, jt.Gravity(mass, [0.0, 0.0, 0.1]), order=2)[2][-1, 2]
+
+    with jax.enable_x64(True):
+        assert jax.eval_shape(last_rate, jnp.array(np.nan)).shape == ()

@@ -296,7 +296,8 @@ def integrate(
     InvalidInputError
         Wrong shapes, batch shapes that do not broadcast, non-numeric input, ``n_steps`` or
         ``save_every`` not a positive int (or ``save_every`` not dividing ``n_steps``), an order other
-        than 2 or 4, or a torque that is not a torque; with concrete values also non-finite
+        than 2 or 4, or a torque that is not a torque; with concrete values also a torque whose
+        parameters, or whose value at the initial state, are not finite, non-finite
         ``quaternion0``, ``omega0``, ``t_end`` or ``t0`` (or, with ``dtype=jnp.float32``, finite values
         that overflow float32), a zero ``quaternion0``, an ``omega0`` whose square or angular momentum
         overflows, ``t_end - t0`` that overflows, or :math:`|\Omega_0|\,|h| > 2^{48}` for a flow of
@@ -314,8 +315,9 @@ def integrate(
     or ``grad`` (traced inputs) only the shapes are checked: a NaN or infinite input, a zero
     ``quaternion0`` or an inertia that is not positive definite then gives NaN outputs without an
     error. Torques of :mod:`eulerpoisson.torques` whose parameters overflow float64 together are
-    refused (``eulerpoisson.model.torque_base.check_torque_scales``); the parameters of a torque
-    built in :mod:`eulerpoisson.jax.torques` are not checked.
+    refused (``eulerpoisson.model.torque_base.check_torque_scales``); a torque built in
+    :mod:`eulerpoisson.jax.torques` with concrete parameters is refused when a parameter, or its value
+    at the initial state, is not finite.
 
     Notes
     -----
@@ -382,7 +384,36 @@ def integrate(
             check_phase(w0, span / n_steps, "h", max(abs(x) for x in composition(order)[1]))
         except InvalidInputError as exc:
             raise InvalidInputError(f"the free flow over a step h = (t_end - t0) / n_steps: {exc}") from None
+    if tq is not None and not any(
+        isinstance(x, jax.core.Tracer) for x in jax.tree_util.tree_leaves((tq, I, q0, w0, ts))
+    ):
+        _check_torque_values(tq, I, q0, w0, ts)
     return _run(I, q0, w0, te, ts, tq, n_steps=n_steps, order=order, save_every=save_every, flow=flow, dtype=dt)
+
+
+def _check_torque_values(tq, I, q0, w0, ts) -> None:
+    """A JAX torque (concrete) whose parameters, or whose value at the initial state, are not finite: an error.
+
+    Covers the torques built in :mod:`eulerpoisson.jax.torques` (those of :mod:`eulerpoisson.torques` are
+    checked by ``check_torque_scales`` too): parameters that overflow together give an infinite or NaN
+    torque, which would otherwise give NaN outputs without an error.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the torque and what is not finite.
+    """
+    name = type(tq).__name__
+    for leaf in jax.tree_util.tree_leaves(tq):
+        if not np.all(np.isfinite(np.asarray(leaf))):
+            raise InvalidInputError(f"torque {name}: a parameter is not finite (NaN or infinite); give finite values")
+    with np.errstate(all="ignore"):
+        tau = np.asarray(tq.evaluate(ts, normalized(q0), w0, I))
+    if not np.all(np.isfinite(tau)):
+        raise InvalidInputError(
+            f"torque {name}: its value at the initial state is not finite (its parameters overflow together, "
+            f"e.g. a mass times a lever arm times g beyond float range); give parameters of a physical scale"
+        )
 
 
 @functools.partial(jax.jit, static_argnames=("n_steps", "order", "save_every", "flow", "dtype"))

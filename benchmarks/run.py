@@ -421,7 +421,10 @@ def _issue25_goals(wp, tp, tq, ft, exact, cold, suite) -> list[dict]:
     r = _row(tq["rows"], "taylor_gravity_ratio") if tq else None
     if r:
         s, f = _row(tq["rows"], "taylor_gravity_step"), _row(tq["rows"], "taylor_free_step")
-        g["measured"] = f"{s['value']:.3g} us vs {f['value']:.3g} us per step"
+        g["measured"] = f"{s['value']:.3g} us vs {f['value']:.3g} us per step (a full tensor)"
+        p = _row(tq["rows"], "taylor_gravity_ratio_principal")
+        if p:  # (informative: the goal is judged on the benchmark's full tensor)
+            g["measured"] += f"; the body given by its principal moments: {p['value']:.3g}x"
         g["ratio"], g["status"] = r["value"], _status(r["value"] <= 1.5)
     goals.append(g)
 

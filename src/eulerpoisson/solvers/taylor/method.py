@@ -815,19 +815,6 @@ class Taylor(Method):
         assert poly is not None  # supports() admits polynomial torques only
         data = poly.flatten(bshape)
         inertia = np.ascontiguousarray(problem.inertia.reshape(B, 3, 3))
-        q0 = problem.q0.reshape(B, 4)
-        w0 = problem.omega0.reshape(B, 3)
-        # a top (one Poisson vector, no orbit: gravity, a space torque) integrates in the principal frame,
-        # where the kernel's angular-velocity equation takes three Cauchy products instead of six
-        # (torque._coefficients_top_principal); a diagonal tensor is a principal frame already
-        principal = data.S.shape[-2] == 1 and not np.any(data.kappa) and not problem.body.is_diagonal
-        if principal:
-            P = np.ascontiguousarray(problem.principal_axes.reshape(B, 3, 3))
-            qP = quaternion_from_rotation_matrix(P)
-            q0 = qmul(q0, qP)
-            w0 = np.einsum("bji,bj->bi", P, w0)
-            data = data.in_frame(P)
-            inertia = problem.principal_moments.reshape(B, 3)[:, :, None] * np.eye(3)
         order = (
             c["order"]
             if c["order"] is not None
@@ -835,8 +822,8 @@ class Taylor(Method):
         )
         q, om, stats, status = integrate_polynomial(
             inertia,
-            q0,
-            w0,
+            problem.q0.reshape(B, 4),
+            problem.omega0.reshape(B, 3),
             data,
             problem.t,
             tol=float(c["tol"]),
@@ -852,8 +839,5 @@ class Taylor(Method):
         if np.any(status == 2):
             b = int(np.flatnonzero(status == 2)[0])
             raise EulerPoissonError(f"taylor: the state of body {b} became non-finite (the motion diverges)")
-        if principal:  # back to the body frame
-            q = qmul(q, (qP * np.array([1.0, -1.0, -1.0, -1.0]))[:, None, :])
-            om = np.einsum("bij,btj->bti", P, om)
         T = problem.t.shape[0]
         return MethodResult(q=q.reshape(bshape + (T, 4)), omega=om.reshape(bshape + (T, 3)), stats=stats)

@@ -162,3 +162,22 @@ def test_plot_and_sweep_outputs_say_what_is_wrong(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 2 and "it is a file, not a Zarr store (a folder) of ours" in err, err
     assert mine.read_text() == "print(1)"
+
+
+@pytest.mark.parametrize("compiled", [True, False, "python"])
+def test_exact_motion_refuses_phases_float64_cannot_place(compiled):
+    """exact_motion (public, unlike the solver's unchecked core): |Omega0||t| beyond 2^48, or Omega0 = M0/I
+    overflowing, is an error on every path (the compiled and NumPy paths gave NaN, the plain-Python one a raw
+    'math domain error')."""
+    from eulerpoisson.solvers.exact.motion import exact_motion
+
+    with pytest.raises(InvalidInputError, match=r"exact_motion: \|Omega0\| \|t\| = 5e\+299 exceeds 2\^48"):
+        exact_motion([1.0, 2.0, 3.0], [0.0, 1e300, 0.0], [1.0], compiled=compiled)
+    with pytest.raises(InvalidInputError, match=r"Omega0 = M0 / I overflows float64 \(body \(1,\)\)"):
+        exact_motion(
+            [[1.0, 2.0, 3.0], [1e-300, 1.0, 1.0]], [[0.0, 1.0, 0.0], [1e10, 0.0, 0.0]], [1.0], compiled=compiled
+        )
+    with pytest.raises(InvalidInputError, match=r"exceeds 2\^48"):
+        exact_motion([1.0, 2.0, 3.0], [0.0, 1.0, 0.5], [2.0**49], compiled=compiled)
+    M, q = exact_motion([1.0, 2.0, 3.0], [0.0, 1.0, 0.5], [0.0, 1e10], compiled=compiled)  # inside the range
+    assert np.isfinite(M).all() and np.isfinite(q).all()

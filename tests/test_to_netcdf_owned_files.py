@@ -51,3 +51,13 @@ def test_a_folder_or_a_store_is_kept(tmp_path, traj):
 def test_a_name_that_cannot_be_meant_is_refused(tmp_path, traj):
     with pytest.raises(InvalidInputError, match="only a suffix"):
         traj.to_netcdf(tmp_path / ".nc")
+
+
+def test_an_empty_file_is_written_over(tmp_path, traj):
+    """(tempfile.mkstemp's file, a placeholder: nothing in it to lose; the command line keeps it, its own policy)"""
+    import tempfile
+
+    fd, name = tempfile.mkstemp(suffix=".nc", dir=tmp_path)
+    os.close(fd)
+    traj.to_netcdf(name)
+    assert ep.Trajectory.from_netcdf(name).t.tolist() == [0.0, 1.0]

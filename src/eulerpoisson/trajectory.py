@@ -459,8 +459,8 @@ class Trajectory:
     def to_netcdf(self, path: str | os.PathLike[str]) -> None:
         """Write the trajectory to a NetCDF-4 file, atomically: :func:`eulerpoisson.io.netcdf.write_netcdf`.
 
-        An existing NetCDF file is replaced; any other file (a configuration, data: recognized by its content),
-        a folder or a store is not.
+        An existing NetCDF file or empty file is replaced; any other file (a configuration, data: recognized by
+        its content), a folder or a store is not.
 
         Raises
         ------

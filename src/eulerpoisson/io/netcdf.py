@@ -169,8 +169,8 @@ def dataset_content(traj: Trajectory) -> tuple[dict, dict, dict]:
 def write_netcdf(traj: Trajectory, path: str | os.PathLike[str]) -> None:
     """Write the trajectory to a NetCDF-4 file, atomically (temporary file, then rename).
 
-    An existing NetCDF file at ``path`` is replaced; any other file (recognized by its content, not its name:
-    a configuration, data, a figure), a folder or a store is not.
+    An existing NetCDF file or empty file at ``path`` is replaced; any other file (recognized by its content,
+    not its name: a configuration, data, a figure), a folder or a store is not.
 
     Raises
     ------
@@ -185,7 +185,7 @@ def write_netcdf(traj: Trajectory, path: str | os.PathLike[str]) -> None:
 
     from .outputs import check_output
 
-    check_output(path, "netcdf", overwrite=True, flag="to_netcdf", option="path")
+    check_output(path, "netcdf", overwrite=True, flag="to_netcdf", option="path", replace_empty=True)
     h5netcdf = require("h5netcdf", "io")
     content, coords, attrs = dataset_content(traj)
     # HDF5 writes into memory first; the file itself is written by plain Python I/O, so a full disk is

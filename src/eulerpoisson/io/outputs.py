@@ -31,6 +31,7 @@ import contextlib
 import json
 import os
 import re
+import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
@@ -141,6 +142,15 @@ def file_kind(path: str | os.PathLike[str]) -> str | None:
             return "trajectory-store"
         return "zarr"
     return "netcdf" if file_format(p) in ("netcdf4", "netcdf3") else "file"
+
+
+def _empty_file(path) -> bool:
+    """A regular file of 0 bytes (not a link to one)."""
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return False
+    return stat.S_ISREG(st.st_mode) and st.st_size == 0
 
 
 def _same_file(a, b) -> bool:
@@ -344,6 +354,7 @@ def check_output(
     inputs: Iterable[str | os.PathLike[str] | None] = (),
     flag: str = "--overwrite",
     option: str = "--out",
+    replace_empty: bool = False,
 ) -> None:
     """Refuse an output that must not be written (before any work is done).
 
@@ -362,6 +373,9 @@ def check_output(
         How the user says "overwrite" (named in the message).
     option : str
         How the user gave ``path`` (named when the name is refused).
+    replace_empty : bool
+        Whether an empty file (0 bytes, such as ``tempfile.mkstemp`` leaves) may be written over where a
+        file is written (the library's writers; the command line keeps every file it did not write).
 
     Raises
     ------
@@ -398,6 +412,8 @@ def check_output(
     have = content_kind(path)
     if have is None:
         return
+    if replace_empty and have == "file" and writes not in _FOLDER_KINDS and _empty_file(path):
+        return  # an empty file (mkstemp's): nothing in it to lose
     if writes == "cases" and have == "folder" and not any(Path(path).iterdir()):
         return  # an empty folder: written into
     if have == "folder":

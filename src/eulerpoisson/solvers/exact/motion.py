@@ -156,6 +156,7 @@ from ...numerics import elliptic as _el
 from ...numerics.doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, two_prod, two_sum
 from ...numerics.quaternion import qmul_components
 from ...util import jit as _jit
+from ...util.validate import MAX_PHASE, scaled_norms
 
 __all__ = [
     "ExactMotion",
@@ -794,7 +795,9 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
         non-positive moment.
     InvalidInputError
         If ``M0`` does not have shape (..., 3) or is not finite, if the batch
-        shapes do not broadcast, or if ``t`` is not a finite 1-d array.
+        shapes do not broadcast, if ``t`` is not a finite 1-d array, or if
+        :math:`\Omega_0 = M_0/I` overflows or :math:`|\Omega_0||t| > 2^{48}`
+        for some body (float64 cannot place the body on its orbit then).
 
     Notes
     -----
@@ -841,13 +844,47 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
     chunk_size = int(chunk_size)
     if chunk_size < 1:
         raise InvalidInputError(f"chunk_size must be a positive integer, got {chunk_size}")
+    if isinstance(compiled, str) and compiled != "python":
+        raise InvalidInputError(f"compiled must be True, False, None or 'python', got {compiled!r}")
+    _check_range(inertia, M0, t)
     if isinstance(compiled, str):
-        if compiled != "python":
-            raise InvalidInputError(f"compiled must be True, False, None or 'python', got {compiled!r}")
         return _exact_motion_compiled(inertia, M0, t, python=True)
     if _jit.USE_NUMBA and compiled is not False:
         return _exact_motion_compiled(inertia, M0, t)
     return _exact_motion_numpy(inertia, M0, t, chunk_size)
+
+
+def _check_range(inertia, M0, t) -> None:
+    r"""Refuse what float64 cannot evaluate: :math:`\Omega_0 = M_0/I` overflowing, or
+    :math:`|\boldsymbol\Omega_0||t| > 2^{48}` (beyond it the rounding of the frequencies shifts the phase by
+    more than 0.1 rad; as ``solve(..., method="exact")`` refuses).
+
+    Raises
+    ------
+    InvalidInertiaError, InvalidInputError
+        As :func:`exact_motion`'s checks; the range, naming the body.
+    """
+    I2, M2, batch = _validate(inertia, M0)
+    if t.size == 0 or I2.shape[0] == 0:
+        return
+    tmax = float(np.max(np.abs(t)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        w = M2 / I2
+        speed = scaled_norms(w)  # (no overflow in the squares; inf or NaN where Omega0 itself overflowed)
+        phase = speed * tmax
+    bad = ~(phase <= MAX_PHASE)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        where = f" (body {tuple(int(k) for k in np.unravel_index(i, batch))})" if batch else ""
+        what = (
+            f"Omega0 = M0 / I overflows float64{where}"
+            if not np.isfinite(speed[i])
+            else f"|Omega0| |t| = {phase[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad"
+        )
+        raise InvalidInputError(
+            f"exact_motion: {what}: float64 cannot say where on its orbit the body is at |t| = {tmax:.6g}; "
+            f"use shorter times or a smaller M0"
+        )
 
 
 def _kernels():

@@ -368,16 +368,20 @@ def _direct_twin(f):
     twins and the lazy intrinsics their Python twins, and the package's plain
     functions (the jitable helpers) direct twins too: the same operations in
     the same order, so the same numbers, about 1.5 times faster. The copy is
-    made once, when the twins first run; a function that writes a module
-    global, or is not a plain function of the package, is left as it is.
+    made once, when the twins first run (a kernel module's globals are its
+    constants); a function of a module without kernels (it reads that
+    module's live globals), one that writes a module global, or one that is
+    not a plain function of the package, is left as it is.
     """
     if type(f) is not types.FunctionType or not f.__module__.startswith("eulerpoisson"):
         return f
     entry = _TWIN_FUNCTIONS.get(id(f))
     if entry is not None:
         return entry[1]
-    if any(ins.opname in _GLOBAL_WRITES for ins in dis.get_instructions(f)):
-        twin = f
+    if not any(isinstance(v, _Lazy) for v in f.__globals__.values()) or any(
+        ins.opname in _GLOBAL_WRITES for ins in dis.get_instructions(f)
+    ):
+        twin = f  # a module without kernels (its functions read its live globals), or a global written
     else:
         twin = types.FunctionType(f.__code__, _twin_namespace(f.__globals__), f.__name__, f.__defaults__, f.__closure__)
         twin.__kwdefaults__ = f.__kwdefaults__

@@ -150,6 +150,9 @@ __all__ = ["lagrange_top_motion", "check_top_ranges"]
 
 _UNIT_TOL = 1e-8
 _BRACKET_ITERS = 200
+#: a rejected Newton step within this many ulp of the iterate: the bracket is closed beside it (_bracket_root)
+_NEWTON_ULPS = 4.0
+_EPS = float(np.finfo(np.float64).eps)
 
 
 # ---------------------------------------------------------------------------
@@ -268,8 +271,11 @@ def _bracket_root(a, lo, hi, increasing):
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             xn = x - f / df
         bad = ~np.isfinite(xn) | (xn <= lo) | (xn >= hi)
+        # a Newton step onto the bracket's end (x itself: converged from one side) closes the bracket with the
+        # neighbouring float on the root's side, not by bisecting the far end down (45-60 iterations)
+        near = bad & np.isfinite(xn) & (np.abs(xn - x) <= _NEWTON_ULPS * _EPS * np.abs(x))
         mid = 0.5 * (lo + hi)
-        xn = np.where(bad, mid, xn)
+        xn = np.where(bad, np.where(near, np.nextafter(x, np.where(f < 0.0, hi, lo)), mid), xn)
         done = (xn == x) | (mid == lo) | (mid == hi) | (f == 0.0)
         x = np.where(done, x, xn)
         if np.all(done):

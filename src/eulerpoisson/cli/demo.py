@@ -350,8 +350,6 @@ def _demo(out: Path, quiet: bool, t_end: float, samples: int) -> int:
         path = out / f"{kind}.png"
         plots.plot(traj, kind, out=path)
         files.append(path)
-    from ..io.atomic import atomic_path, atomic_write_text
-    from ..io.outputs import mark_text
     from ..viz.animate import animate
 
     anim = out / "tennis_racket.html"
@@ -359,23 +357,17 @@ def _demo(out: Path, quiet: bool, t_end: float, samples: int) -> int:
     from ..trajectory import Trajectory
 
     light = Trajectory(traj.t[sub], traj.quaternion[sub], traj.omega[sub], body, traj.method, traj.options)
-    with atomic_path(anim, suffix=".html") as tmp:  # the page, marked (recognized as ours on a rerun), then renamed
-        animate(light, tmp)
-        page = Path(tmp).read_text(encoding="utf-8")
-        Path(tmp).write_text(mark_text(page, "animation", "html"), encoding="utf-8")
+    animate(light, anim)  # (marked as ours by animate: recognized on a rerun)
     files.append(anim)
     top_lines: list[str] = []
     files.extend(_top_scene(out, top_lines.append, HEAVY_TOP["t_end"], HEAVY_TOP["samples"]))
     fit_lines: list[str] = []
     files.extend(_fit_scene(out, fit_lines.append))
-    from ..paper.audit import run_audit
+    from ..paper.audit import run_audit, write_report
 
     report = run_audit()
     for fmt in ("md", "json"):
-        path = out / f"audit.{fmt}"
-        text = {"md": report.to_markdown, "json": report.to_json}[fmt]()
-        atomic_write_text(path, mark_text(text, "audit-report", fmt))  # marked as ``eulerpoisson audit`` does
-        files.append(path)
+        files.append(Path(write_report(report, fmt, out / f"audit.{fmt}")))  # (marked as ours)
 
     wall = time.perf_counter() - t0
     say("eulerpoisson demo: the tennis-racket effect")

@@ -89,8 +89,7 @@ def _fps(text) -> float:
 
 
 def cmd_animate(args) -> int:
-    from ..io.atomic import atomic_path
-    from ..io.outputs import check_output_name, claim_output, mark_text
+    from ..io.outputs import check_output_name, claim_output
     from ..viz.animate import FORMATS, animate, default_duration
 
     check_file_name(args.out, "--out")
@@ -122,14 +121,7 @@ def cmd_animate(args) -> int:
                     f"--fps {args.fps}: a {dur:g} s movie would have {nframes} frames, more than {MAX_FRAMES}; "
                     f"use --fps {int(MAX_FRAMES // dur)} or less"
                 )
-            animate(traj, args.out, fps=fps)
-        else:  # a page of ours: written next to its name, marked (so that --overwrite knows it), then renamed
-            with atomic_path(args.out, suffix="." + ext) as tmp:
-                animate(traj, tmp, fps=fps)
-                with open(tmp, encoding="utf-8") as fh:
-                    page = fh.read()
-                with open(tmp, "w", encoding="utf-8") as fh:
-                    fh.write(mark_text(page, "animation", "html"))
+        animate(traj, args.out, fps=fps)  # (a page is marked as ours by animate: --overwrite knows it)
     if not args.quiet:
         print(f"wrote {args.out}")
     return 0

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import InvalidInputError
 from ..io.atomic import atomic_write_text
+from ..io.outputs import mark_text
 from .audit_checks import EntryResult
 from .symbolic import sympy_module as _sp
 
@@ -461,7 +462,8 @@ def _tex_math_block(s: str) -> str:
 
 
 def write_report(report: AuditReport, fmt: str, path: str | os.PathLike[str]) -> str:
-    """Write a report atomically (temporary file in the target directory, then :func:`os.replace`).
+    """Write a report atomically (temporary file in the target directory, then :func:`os.replace`), marked as
+    written by eulerpoisson (:func:`eulerpoisson.io.outputs.mark_text`).
 
     Parameters
     ----------
@@ -485,7 +487,10 @@ def write_report(report: AuditReport, fmt: str, path: str | os.PathLike[str]) ->
     if not isinstance(fmt, str) or fmt.lower() not in FORMATS:
         raise InvalidInputError(f"unknown format {fmt!r}; expected one of {sorted(FORMATS)}")
     kind = FORMATS[fmt.lower()]
-    text = {"md": report.to_markdown, "json": report.to_json, "tex": report.to_latex}[kind]()
+    # marked as ours (io.outputs.content_kind: ``audit --overwrite`` may replace it, never another file)
+    text = mark_text(
+        {"md": report.to_markdown, "json": report.to_json, "tex": report.to_latex}[kind](), "audit-report", kind
+    )
     path = os.fspath(path)
     directory = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(directory):

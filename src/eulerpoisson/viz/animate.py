@@ -49,6 +49,7 @@ from numpy.typing import ArrayLike
 
 from ..errors import InvalidInputError, MissingDependencyError
 from ..io.atomic import atomic_path
+from ..io.outputs import mark_text
 from ..util.validate import as_float_array
 from .plots import AXIS_COLORS, import_matplotlib, plain_text, select_body
 
@@ -380,7 +381,8 @@ def animate(
     mn = float(np.linalg.norm(m0))
     mdir = m0 / mn if mn > 0 else None
     if ext == "html":
-        text = _html_page(one, sides, verts, faces, mdir, dur, px, int(max_samples))
+        # marked as ours (io.outputs.content_kind: a command's --overwrite may replace it, never another page)
+        text = mark_text(_html_page(one, sides, verts, faces, mdir, dur, px, int(max_samples)), "animation", "html")
         with atomic_path(p, suffix=".html") as tmp:
             with open(tmp, "w", encoding="utf-8") as fh:
                 fh.write(text)

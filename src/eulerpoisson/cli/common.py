@@ -268,7 +268,7 @@ def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
     """
     from ..attitude.core import Attitude
     from ..model.torque_base import scaled_norms, torque_bound
-    from ..solvers.exact.method import MAX_PHASE
+    from ..util.validate import MAX_PHASE
 
     body = model.body
     inertia = np.asarray(body.inertia, dtype=float)

@@ -14,6 +14,76 @@ from ..errors import InvalidInputError
 MAX_PHASE = 2.0**48
 
 
+def check_phase(
+    t: np.ndarray, w: np.ndarray, speed=None, *, who: str = "exact", what: str = "|omega0| |t|", rate: str = "omega0"
+) -> None:
+    r"""Refuse times at which float64 no longer determines the phase of a motion: :math:`|\Omega_0||t| > 2^{48}`.
+
+    The frequencies of the motion are rounded numbers: a relative error of a few ulp becomes a phase
+    error of about :math:`4\varepsilon|\boldsymbol\Omega||t|`, more than a tenth of a radian beyond
+    :data:`MAX_PHASE`: an error instead of a silent guess.
+
+    Parameters
+    ----------
+    t : ndarray, shape (T,)
+        The times (finite).
+    w : ndarray, shape (*batch, 3)
+        The initial rates :math:`\boldsymbol\Omega_0` (an overflowed one, inf, is refused too).
+    speed : ndarray, shape (*batch), optional
+        Replaces :math:`|\boldsymbol\Omega_0|` (a heavy top's rate includes :math:`\sqrt{\mu g\ell/A}`).
+    who, what, rate : str
+        The message's prefix, the phase's name and the rate's name.
+
+    Raises
+    ------
+    InvalidInputError
+        Naming the body (its index in the batch) and the phase, or the rate that overflowed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_phase(np.array([0.0, 1e3]), np.array([1.0, 0.0, 0.0]))
+    >>> check_phase(np.array([1e15]), np.array([1.0, 0.0, 0.0]))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    eulerpoisson.errors.InvalidInputError: exact: |omega0| |t| = 1e+15 exceeds 2^48 = 2.81e+14 rad: ...
+    """
+    if t.size == 0:
+        return
+    few = w.ndim == 1 and t.size <= 16  # one body at a few times: the maxima in plain floats
+    tmax = max(map(abs, t.tolist())) if few else float(np.abs(t).max())
+    if speed is None:
+        # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
+        wmax = max(map(abs, w.tolist())) if few else max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
+        if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
+            return
+        with np.errstate(over="ignore"):
+            w2 = np.sum(w * w, axis=-1)
+        # the common case in one pass: every |Omega0| t well inside the range (no square roots)
+        if float(np.max(w2, initial=0.0)) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
+            return
+        speed = np.sqrt(w2)
+        if not np.all(np.isfinite(speed)):  # |Omega0| beyond 1e154: its square overflowed, not (always) the rate
+            with np.errstate(invalid="ignore"):
+                speed = scaled_norms(w)
+    with np.errstate(over="ignore", invalid="ignore"):
+        phase = np.asarray(speed * tmax)
+    bad = ~(phase <= MAX_PHASE)  # (NaN: an infinite rate)
+    if np.any(bad):
+        flat = np.reshape(phase, -1)
+        i = int(np.flatnonzero(np.reshape(bad, -1))[0])
+        where = f" (body {tuple(int(k) for k in np.unravel_index(i, phase.shape))})" if phase.ndim else ""
+        if not np.isfinite(np.reshape(speed, -1)[i]):
+            raise InvalidInputError(
+                f"{who}: {rate} overflows float64{where}: float64 cannot say where on its orbit the body is"
+            )
+        raise InvalidInputError(
+            f"{who}: {what} = {flat[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad: at |t| = {tmax:.6g} "
+            f"the rounding of the frequencies (a few ulp) already shifts the phase of the motion by more than "
+            f"0.1 rad, so float64 cannot say where on its orbit the body is; use shorter times"
+        )
+
+
 def describe_value(x) -> str:
     a = np.asarray(x)
     if a.size <= 6:

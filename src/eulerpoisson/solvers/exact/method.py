@@ -38,21 +38,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...attitude.core import quaternion_from_rotation_matrix
-from ...errors import InvalidInputError
 from ...numerics.quaternion import qmul
 from ...util import jit
-from ...util.validate import MAX_PHASE
+from ...util.validate import MAX_PHASE as MAX_PHASE  # (the limit it enforces, read by tests and callers)
+from ...util.validate import check_phase
 from ..problem import Problem, compose_initial, left_composed
 from ..registry import Method, MethodOptions, MethodResult, overrides, register_method
 
 __all__ = ["Exact"]
 
 
-#: largest |Omega| |t| the closed form accepts (2^48, about 2.8e14 radians)
-
-
 def _check_phase_range(problem: Problem, speed=None) -> None:
-    r"""Refuse times at which float64 no longer determines the phase of the motion.
+    r"""Refuse times at which float64 no longer determines the phase of the motion
+    (:func:`~eulerpoisson.util.validate.check_phase`).
 
     The frequencies of the motion (the elliptic :math:`\lambda` and the
     precession rate, both of the order of :math:`|\boldsymbol\Omega|`) are
@@ -69,44 +67,8 @@ def _check_phase_range(problem: Problem, speed=None) -> None:
         (``speed`` replaces :math:`|\boldsymbol\Omega_0|` when given: a
         heavy top's rate includes :math:`\sqrt{\mu g\ell/A}`).
     """
-    _check_phase(problem.t, problem.omega0, speed)
-
-
-def _check_phase(t: np.ndarray, w: np.ndarray, speed=None) -> None:
-    """:func:`_check_phase_range` on the times ``t`` (T,) and initial rates ``w`` (*batch, 3)."""
-    if t.size == 0:
-        return
-    few = w.ndim == 1 and t.size <= 16  # one body at a few times: the maxima in plain floats
-    tmax = max(map(abs, t.tolist())) if few else float(np.abs(t).max())
-    if speed is None:
-        # the common case without a temporary array: |Omega0|^2 <= 3 max|Omega0_i|^2 (4: room for rounding)
-        wmax = max(map(abs, w.tolist())) if few else max(float(np.max(w, initial=0.0)), -float(np.min(w, initial=0.0)))
-        if tmax == 0.0 or 4.0 * (wmax * wmax) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
-            return
-        with np.errstate(over="ignore"):
-            w2 = np.sum(w * w, axis=-1)
-        # the common case in one pass: every |Omega0| t well inside the range (no square roots)
-        if tmax == 0.0 or float(np.max(w2, initial=0.0)) * (tmax * tmax) <= 0.25 * MAX_PHASE * MAX_PHASE:
-            return
-        speed = np.sqrt(w2)
-        if not np.all(np.isfinite(speed)):  # |Omega0| beyond 1e154: its square overflowed, not the rate
-            from ...util.validate import scaled_norms
-
-            speed = scaled_norms(w)
-        what = "|omega0| |t|"
-    else:
-        what = "(|omega0| + sqrt(mass |g| |ell| / A)) |t|"  # a heavy top's rate
-    with np.errstate(over="ignore"):
-        phase = speed * tmax
-    if np.any(phase > MAX_PHASE):
-        flat = np.reshape(phase, -1)
-        i = int(np.argmax(flat))
-        where = f" (body {tuple(int(k) for k in np.unravel_index(i, phase.shape))})" if phase.ndim else ""
-        raise InvalidInputError(
-            f"exact: {what} = {flat[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad: at |t| = {tmax:.6g} "
-            f"the rounding of the frequencies (a few ulp) already shifts the phase of the motion by more than "
-            f"0.1 rad, so float64 cannot say where on its orbit the body is; use shorter times"
-        )
+    what = "|omega0| |t|" if speed is None else "(|omega0| + sqrt(mass |g| |ell| / A)) |t|"  # a heavy top's rate
+    check_phase(problem.t, problem.omega0, speed, what=what)
 
 
 @dataclass(frozen=True)
@@ -222,7 +184,7 @@ class Exact(Method):
             return None  # (a subclass that decides or runs otherwise: the general route, through its own methods)
         T = t.shape[0]
         path = self._path if self._path is not None else _one_body_path(T)
-        _check_phase(t, omega0)
+        check_phase(t, omega0)
         Ip = body.principal_moments
         motion = _MOTION if _MOTION is not None else _motion()
         Mp, q_rel = motion.one_body_motion(Ip, Ip * omega0, t, compiled=_COMPILED_ARG.get(path, path))

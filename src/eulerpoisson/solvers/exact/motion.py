@@ -156,7 +156,7 @@ from ...numerics import elliptic as _el
 from ...numerics.doubledouble import dd_add, dd_mul, dd_mul_d, quick_two_sum, two_prod, two_sum
 from ...numerics.quaternion import qmul_components
 from ...util import jit as _jit
-from ...util.validate import MAX_PHASE, scaled_norms
+from ...util.validate import check_phase
 
 __all__ = [
     "ExactMotion",
@@ -856,8 +856,8 @@ def exact_motion(inertia, M0, t, *, chunk_size=_DEFAULT_CHUNK, compiled=None):
 
 def _check_range(inertia, M0, t) -> None:
     r"""Refuse what float64 cannot evaluate: :math:`\Omega_0 = M_0/I` overflowing, or
-    :math:`|\boldsymbol\Omega_0||t| > 2^{48}` (beyond it the rounding of the frequencies shifts the phase by
-    more than 0.1 rad; as ``solve(..., method="exact")`` refuses).
+    :math:`|\boldsymbol\Omega_0||t| > 2^{48}` (:func:`~eulerpoisson.util.validate.check_phase`, as
+    ``solve(..., method="exact")`` refuses).
 
     Raises
     ------
@@ -865,26 +865,9 @@ def _check_range(inertia, M0, t) -> None:
         As :func:`exact_motion`'s checks; the range, naming the body.
     """
     I2, M2, batch = _validate(inertia, M0)
-    if t.size == 0 or I2.shape[0] == 0:
-        return
-    tmax = float(np.max(np.abs(t)))
-    with np.errstate(over="ignore", invalid="ignore"):
-        w = M2 / I2
-        speed = scaled_norms(w)  # (no overflow in the squares; inf or NaN where Omega0 itself overflowed)
-        phase = speed * tmax
-    bad = ~(phase <= MAX_PHASE)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
-        where = f" (body {tuple(int(k) for k in np.unravel_index(i, batch))})" if batch else ""
-        what = (
-            f"Omega0 = M0 / I overflows float64{where}"
-            if not np.isfinite(speed[i])
-            else f"|Omega0| |t| = {phase[i]:.3g}{where} exceeds 2^48 = {MAX_PHASE:.3g} rad"
-        )
-        raise InvalidInputError(
-            f"exact_motion: {what}: float64 cannot say where on its orbit the body is at |t| = {tmax:.6g}; "
-            f"use shorter times or a smaller M0"
-        )
+    with np.errstate(over="ignore"):
+        w = (M2 / I2).reshape(batch + (3,))
+    check_phase(t, w, who="exact_motion", what="|Omega0| |t|", rate="Omega0 = M0 / I")
 
 
 def _kernels():

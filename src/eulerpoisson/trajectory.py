@@ -112,18 +112,11 @@ def stored_attitudes(t: np.ndarray, quaternion, omega) -> np.ndarray:
         and omega.dtype == _FLOAT64
         and quaternion.shape[1:] == (4,)
         and omega.shape[-1:] == (3,)
+        and math.isfinite(sum(quaternion.ravel().tolist()) + sum(omega.ravel().tolist()))
     ):
-        # a few samples: the checks in plain floats (the sum, not each value, to spare Python calls: an
-        # infinite or NaN value makes it so)
-        rows = quaternion.tolist()
-        if len(rows) == 1:  # one sample: stored as it is when of unit norm (finite then), as _unit_continuous does
-            w, x, y, z = rows[0]
-            if abs(math.sqrt(w * w + x * x + y * y + z * z) - 1.0) <= _UNIT_SLACK and math.isfinite(
-                sum(omega.ravel().tolist())
-            ):
-                return quaternion
-        if math.isfinite(sum(map(sum, rows)) + sum(omega.ravel().tolist())):
-            return _unit_continuous(t, quaternion)
+        # a few samples whose values are all finite (an infinite or NaN one makes the sum so): the checks in
+        # plain floats (the sum, not each value, to spare Python calls)
+        return _unit_continuous(t, quaternion)
     q = as_float_array(quaternion, "quaternion", (4,))
     as_float_array(omega, "omega", (3,))
     return _unit_continuous(t, q)

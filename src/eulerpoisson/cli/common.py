@@ -267,8 +267,8 @@ def check_run_scales(model, omega0, m0, q0, t_end: float, name) -> None:
     the angular momentum |m| = |I omega| = 1.12e+308 of --inertia and --omega overflows float64 ...
     """
     from ..attitude.core import Attitude
-    from ..model.torque_base import scaled_norms, torque_bound
-    from ..util.validate import MAX_PHASE
+    from ..model.torque_base import torque_bound
+    from ..util.validate import MAX_PHASE, scaled_norms
 
     body = model.body
     inertia = np.asarray(body.inertia, dtype=float)

@@ -35,7 +35,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from ..errors import InvalidInertiaError, InvalidInputError
-from ..util.validate import MAX_PHASE
+from ..util.validate import MAX_PHASE, scaled_norms
 from .doubledouble import (
     dd_add,
     dd_mul,
@@ -692,10 +692,7 @@ def check_inputs(inertia, quaternion0, omega0, times, *, tensor: bool, raw=None)
 
 def _speed(w):
     """``|w|`` along the last axis (NumPy, concrete), without overflow of the squares."""
-    w = np.abs(np.asarray(w, dtype=np.float64))
-    big = np.max(w, axis=-1, initial=0.0)
-    safe = np.where(big > 0.0, big, 1.0)
-    return big * np.sqrt(np.sum((w / safe[..., None]) ** 2, axis=-1))
+    return scaled_norms(np.asarray(w, dtype=np.float64))
 
 
 def check_phase(omega0, t, what: str = "t", factor: float = 1.0) -> None:

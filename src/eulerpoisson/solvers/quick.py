@@ -104,12 +104,7 @@ def _floats(x: Any, n: int | None) -> list[float] | None:
         return None
     out = []
     for v in seq:
-        if type(v) is float:  # (the common case, without a call)
-            if v - v != 0.0:  # inf or NaN
-                return None
-            out.append(v)
-            continue
-        f = _number(v)
+        f = (v if math.isfinite(v) else None) if type(v) is float else _number(v)
         if f is None:
             return None
         out.append(f)
@@ -222,16 +217,14 @@ def quick_solve(
             q0 = initial_quaternion(attitude0, None).copy()
         except (TypeError, InvalidInputError):
             return None
+    # a body given by its moments: checked once per distinct moments (arrays of its own), its support in the plan
+    b = body if moments is None else cached_body(moments)
+    model = Model(b)
     if moments is None:
-        b = body
-        model = Model(b)
         try:
             check_supported(m, model)  # the configured method: its options count (a free-body-only scheme)
         except (TypeError, ValueError):  # (InvalidInputError is a ValueError)
             return None
-    else:
-        b = cached_body(moments)  # (checked once per distinct moments; arrays of its own)
-        model = Model(b)
     if not cls.negative_times and min(times) < 0:
         return None
     tt = np.array(times)

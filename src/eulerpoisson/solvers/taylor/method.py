@@ -90,6 +90,7 @@ Anwendungen* (1960). A. Griewank and A. Walther, *Evaluating Derivatives*,
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from contextlib import nullcontext as _nullcontext
@@ -708,21 +709,18 @@ class Taylor(Method):
     def _integrate(self, moments, w0, q0, t, lanes):
         """The float64 free-body integration of :meth:`run` in the principal frame: ``(q, omega, stats)``."""
         # the options were checked with the method, the arrays with the problem (integrate_principal's checks)
-        kopts = self.__dict__.get("_kernel_options")
-        if kopts is None:  # (normalized once per configured method: a method's options do not change)
-            c = self.config
-            dt = c["dt"]
-            tol = float(c["tol"])
-            order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
-            kopts = self._kernel_options = (
-                tol,
-                int(order),
-                None if dt is None else float(dt),
-                int(c["max_steps"]),
-                float(c["chart_threshold"]),
-            )
-        tol, order, dt, max_steps, threshold = kopts
+        tol, order, dt, max_steps, threshold = self._kernel_options
         return _integrate_checked(moments, w0, q0, t, tol, order, dt, max_steps, threshold, bool(_k.USE_NUMBA), lanes)
+
+    @functools.cached_property
+    def _kernel_options(self) -> tuple[float, int, float | None, int, float]:
+        """``(tol, order, dt, max_steps, chart_threshold)`` as the kernels take them (normalized once: a configured
+        method's options do not change)."""
+        c = self.config
+        dt = c["dt"]
+        tol = float(c["tol"])
+        order = c["order"] if c["order"] is not None else (auto_order(tol) if dt is None else DEFAULT_FIXED_ORDER)
+        return tol, int(order), None if dt is None else float(dt), int(c["max_steps"]), float(c["chart_threshold"])
 
     def run(self, problem: Problem) -> MethodResult:
         if not problem.model.is_free:

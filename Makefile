@@ -42,7 +42,7 @@ demo: $(VENV)/.installed-all
 browser:
 	@command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 || \
 	  ( [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1 && \
-	    timeout 300 sh -c 'apt-get update -qq >/dev/null 2>&1; DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null 2>&1' && \
+	    timeout 300 sh -c 'apt-get update -qq >/dev/null 2>&1; DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium >/dev/null 2>&1' && \
 	    echo "installed chromium for the browser test" ) || \
 	  echo "chromium is not available: the browser test will be skipped"
 
@@ -59,9 +59,13 @@ mujoco: $(VENV)/.installed-test
 	  echo "pybullet is not available: its conformance tests will be skipped"
 
 # the numba kernels are compiled once, two groups at a time, before the tests (which then load them from the cache
-# instead of compiling the same kernels in each pytest-xdist worker)
-test: $(VENV)/.installed-test browser mujoco
-	$(BIN)/eulerpoisson warmup
+# instead of compiling the same kernels in each pytest-xdist worker); Chromium (mostly a download: about 30 s) is
+# installed meanwhile from the start, MuJoCo and PyBullet during the warm-up
+test:
+	@$(MAKE) --no-print-directory browser & \
+	$(MAKE) --no-print-directory $(VENV)/.installed-test && \
+	{ $(MAKE) --no-print-directory mujoco & $(BIN)/eulerpoisson warmup; }; \
+	status=$$?; wait; exit $$status
 	$(BIN)/python -m pytest -n $(WORKERS) --dist loadgroup -q
 
 # optional peers of the benchmark (heyoka, MuJoCo): installed where possible, skipped otherwise

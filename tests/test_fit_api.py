@@ -91,6 +91,10 @@ def _noisy_attitude(q, sigma, rng):
 T11 = np.linspace(0.0, 5.0, 11)
 Q11, W11 = _motion(MOMENTS, T11)
 A_BODY = np.array([0.0, 0.6, 0.8])
+#: one start off the truth of (MOMENTS, W0, Q0), for the tests of what the search does not decide (how an input
+#: is read, a sigma, max_iter, the result object): the default starts (about 40 for attitudes alone, a second of
+#: CPU each fit) are tested where they are the point (noise-free recovery, aliases, units of sigma, ...)
+START = {"inertia": np.diag([0.26, 0.32, 0.42]) * 5, "omega0": [0.12, 0.18, 1.01]}
 
 
 # ----------------------------------------------------------------------------
@@ -115,6 +119,55 @@ def exact():
     t = np.linspace(1.0, 11.0, 31)
     q, w = _motion(MOMENTS, t - 1.0)
     return ep.fit(t, attitude=q, attitude_sigma=1e-3, omega=w, omega_sigma=1e-3), dict(t=t, q=q, w=w)
+
+
+@pytest.fixture(scope="module")
+def noisy_estimated(noisy):
+    """The data of ``noisy`` with both sigmas estimated from the residuals: the result."""
+    _, d = noisy
+    return ep.fit(d["t"], attitude=d["qn"], omega=d["wn"])
+
+
+@pytest.fixture(scope="module")
+def attitudes25():
+    """Noise-free attitudes alone, 25 samples, from the default starts: (result, t, q)."""
+    t = np.linspace(0.0, 8.0, 25)
+    q, _ = _motion(MOMENTS, t)
+    return ep.fit(t, attitude=q, attitude_sigma=1e-3), t, q
+
+
+@pytest.fixture(scope="module")
+def full_tensor():
+    """Noise-free attitudes of a body whose principal axes are not the frame's, a full tensor fitted from the
+    default starts: (result, data)."""
+    rng = np.random.default_rng(5)
+    Rb = Rotation.random(random_state=rng).as_matrix()
+    moments = np.array([0.22, 0.35, 0.43])
+    I = Rb @ np.diag(moments) @ Rb.T
+    t = np.linspace(0.0, 15.0, 40)
+    w0 = np.array([0.3, -0.4, 0.9])
+    q0 = Rotation.random(random_state=rng).as_quat(scalar_first=True)
+    q, _ = _motion(I, t, omega0=w0, attitude0=q0)
+    res = ep.fit(t, attitude=q, attitude_sigma=1e-3, principal_axes="fit")
+    return res, dict(Rb=Rb, moments=moments, I=I, t=t, w0=w0, q0=q0, q=q)
+
+
+@pytest.fixture(scope="module")
+def dense_fits():
+    """``get(n, span)``: noisy attitudes alone at n even times over ``span`` from the default starts, each
+    computed once: (t, noisy attitudes, result)."""
+    done = {}
+
+    def get(n, span):
+        if (n, span) not in done:
+            rng = np.random.default_rng(7)
+            t = np.linspace(0.0, span, n)
+            q, _ = _motion(MOMENTS, t)
+            qn = _noisy_attitude(q, 2e-3, rng)
+            done[(n, span)] = t, qn, ep.fit(t, attitude=qn, attitude_sigma=2e-3)
+        return done[(n, span)]
+
+    return get
 
 
 @pytest.fixture(scope="module")
@@ -331,7 +384,7 @@ def test_max_iter_must_be_an_integer(max_iter):
 
 
 def test_max_iter_accepts_numpy_integers():
-    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=np.int64(50))
+    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=np.int64(50), initial=START)
     _assert_recovers(res, MOMENTS, W0, Q0)
 
 
@@ -340,14 +393,15 @@ def test_sigma_may_be_nan_where_the_observation_is_missing():
     q[4] = np.nan
     sig = np.full(11, 1e-3)
     sig[4] = np.nan  # no observation there: not used
-    res = ep.fit(T11, attitude=q, attitude_sigma=sig)
+    res = ep.fit(T11, attitude=q, attitude_sigma=sig, initial=START)
+    _assert_recovers(res, MOMENTS, W0, Q0)
     assert res.residuals["attitude"].shape == (10, 3)
     assert 4 not in np.searchsorted(T11, res.residuals["attitude_t"])
 
 
 def test_max_iter_one_reports_not_converged():
     """max_iter = 0 is refused (issue 22 #12); one iteration from a start far off does not converge, and says so."""
-    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=1, accept_poor_fit=True)
+    res = ep.fit(T11, attitude=Q11, attitude_sigma=1e-3, max_iter=1, accept_poor_fit=True, initial=START)
     if not res.converged:
         assert "NOT converged" in res.summary()
 
@@ -356,26 +410,28 @@ def test_max_iter_one_reports_not_converged():
 # 2. inputs accepted
 
 
-def test_attitude_object_and_scipy_rotation_are_converted_right():
-    t = np.linspace(0.0, 8.0, 25)
-    q, _ = _motion(MOMENTS, t)
+def test_attitude_object_and_scipy_rotation_are_converted_right(attitudes25):
+    base, t, q = attitudes25
     scalar_last = np.roll(q, -1, axis=1)  # what scipy holds internally
     rot = Rotation.from_quat(scalar_last)
     assert np.allclose(np.abs(np.sum(rot.as_quat(scalar_first=True) * q, 1)), 1.0)
-    fits = [ep.fit(t, attitude=a, attitude_sigma=1e-3) for a in (q, ep.Attitude(q), rot, q.tolist())]
+    # the array from the default starts; each other form from one start off the truth (an input read wrong
+    # cannot be fitted from there either: the search sees only the converted data)
+    fits = [base] + [
+        ep.fit(t, attitude=a, attitude_sigma=1e-3, initial=START) for a in (ep.Attitude(q), rot, q.tolist())
+    ]
     for r in fits:
         _assert_recovers(r, MOMENTS, W0, Q0)
         assert abs(r.chi2 - fits[0].chi2) < 1e-12
-    # the scalar-last array itself, read as scalar-first, is another motion: not what was observed
-    wrong = ep.fit(t, attitude=scalar_last, attitude_sigma=1e-3, accept_poor_fit=True)
+    # the scalar-last array itself, read as scalar-first, is another motion: not what was observed (from the same
+    # start, which recovers the truth from each right reading)
+    wrong = ep.fit(t, attitude=scalar_last, attitude_sigma=1e-3, accept_poor_fit=True, initial=START)
     assert _angle(wrong.attitude0.as_quaternion(), Q0) > 0.1
 
 
-def test_quaternion_sign_does_not_matter():
-    t = np.linspace(0.0, 8.0, 25)
-    q, _ = _motion(MOMENTS, t)
+def test_quaternion_sign_does_not_matter(attitudes25):
+    base, t, q = attitudes25
     flips = np.where(np.random.default_rng(3).random(len(t)) < 0.5, -1.0, 1.0)[:, None]
-    base = ep.fit(t, attitude=q, attitude_sigma=1e-3)
     for qq in (-q, flips * q):
         r = ep.fit(t, attitude=qq, attitude_sigma=1e-3)
         assert np.abs(r.inertia - base.inertia).max() < 1e-12
@@ -555,16 +611,9 @@ def test_fixed_inertia():
     assert np.abs(r.omega0 - W0).max() < 1e-12
 
 
-def test_full_tensor_principal_axes_fit():
-    rng = np.random.default_rng(5)
-    Rb = Rotation.random(random_state=rng).as_matrix()
-    moments = np.array([0.22, 0.35, 0.43])
-    I = Rb @ np.diag(moments) @ Rb.T
-    t = np.linspace(0.0, 15.0, 40)
-    w0 = np.array([0.3, -0.4, 0.9])
-    q0 = Rotation.random(random_state=rng).as_quat(scalar_first=True)
-    q, _ = _motion(I, t, omega0=w0, attitude0=q0)
-    res = ep.fit(t, attitude=q, attitude_sigma=1e-3, principal_axes="fit")
+def test_full_tensor_principal_axes_fit(full_tensor):
+    res, d = full_tensor
+    Rb, moments, I, t, w0, q0, q = (d[k] for k in ("Rb", "moments", "I", "t", "w0", "q0", "q"))
     assert res.principal_axes_mode == "fit"
     assert res.parameter_names[-5:] == ("I_xx", "I_yy", "I_xy", "I_xz", "I_yz")
     _assert_recovers(res, I, w0, q0)
@@ -711,27 +760,28 @@ def test_to_json(noisy, tmp_path):
     assert json.loads((tmp_path / "second.json").read_text()) == d
 
 
-def test_summary_names_every_parameter(noisy, exact):
+def test_summary_names_every_parameter(noisy, full_tensor):
     res, _ = noisy
     s = res.summary()
     for name in list(res.parameter_names) + ["I_zz"]:
         assert name in s
     assert "reduced chi2" in s and res.mode in s
-    full = ep.fit(exact[1]["t"], attitude=exact[1]["q"], attitude_sigma=1e-3, principal_axes="fit")
+    full, _ = full_tensor
+    assert full.principal_axes_mode == "fit"
     s = full.summary()
     for name in list(full.parameter_names) + ["I_zz", "I_1", "I_2", "I_3"]:
         assert name in s
 
 
-def test_local_optima_sorted_best_first(noisy):
-    res, d = noisy
+def test_local_optima_sorted_best_first(noisy, noisy_estimated):
+    res, _ = noisy
     chi = [o.chi2 for o in res.local_optima]
     assert chi == sorted(chi)
     assert chi[0] == pytest.approx(res.chi2, rel=1e-12)
     best = res.local_optima[0]
     assert np.abs(best.inertia - res.inertia).max() < 1e-12
     # also when the sigma is estimated from the residuals (after the re-weighting)
-    est = ep.fit(d["t"], attitude=d["qn"], omega=d["wn"])
+    est = noisy_estimated
     assert len(est.local_optima) >= 1
     chi = [o.chi2 for o in est.local_optima]
     assert chi == sorted(chi) and chi[0] == pytest.approx(est.chi2, rel=1e-12)
@@ -777,7 +827,7 @@ def test_result_arrays_are_frozen():
     assert np.abs(res.body.inertia - _trace1(MOMENTS)).max() < 1e-15
 
 
-def test_sigma_estimated_from_the_residuals(noisy):
+def test_sigma_estimated_from_the_residuals(noisy, noisy_estimated):
     _, d = noisy
     res = ep.fit(d["t"], omega=d["wn"])
     assert res.sigma_estimated == ("omega",)
@@ -785,7 +835,7 @@ def test_sigma_estimated_from_the_residuals(noisy):
     assert res.reduced_chi2 == pytest.approx(1.0, abs=1e-3)  # by construction, for one kind
     assert "sigma estimated" in res.summary()
     # two kinds, both estimated
-    both = ep.fit(d["t"], attitude=d["qn"], omega=d["wn"])
+    both = noisy_estimated
     assert both.sigma_estimated == ("attitude", "omega")
     assert both.sigma["attitude"] == pytest.approx(2e-3, rel=0.15)
     assert both.sigma["omega"] == pytest.approx(3e-3, rel=0.15)
@@ -802,7 +852,7 @@ def test_to_json_when_the_data_do_not_determine_the_inertia():
     """Spin about a principal axis (no nutation) does not show the inertia: NaN standard errors, written as null."""
     t = np.linspace(0.0, 10.0, 30)
     q, _ = _motion(MOMENTS, t, omega0=[0.0, 0.0, 1.0])
-    res = ep.fit(t, attitude=q, attitude_sigma=1e-3)
+    res = ep.fit(t, attitude=q, attitude_sigma=1e-3, initial={**START, "omega0": [0.02, -0.01, 0.98]})
     assert not res.determined
     assert np.isnan(res.covariance).all() and np.isnan(res.stderr["I_xx"])
     assert "do not determine" in res.summary()
@@ -887,23 +937,15 @@ def test_sparse_rates_only():
 
 
 @pytest.mark.parametrize("n, span", [(49, 12.0), (12, 8.0)], ids=["49 samples", "12 samples"])
-def test_noisy_dense_attitudes_give_the_slow_motion(n, span):
-    rng = np.random.default_rng(7)
-    t = np.linspace(0.0, span, n)
-    q, _ = _motion(MOMENTS, t)
-    qn = _noisy_attitude(q, 2e-3, rng)
-    res = ep.fit(t, attitude=qn, attitude_sigma=2e-3)
+def test_noisy_dense_attitudes_give_the_slow_motion(dense_fits, n, span):
+    t, _, res = dense_fits(n, span)
     assert np.linalg.norm(res.omega0) * (t[1] - t[0]) < np.pi  # under half a turn between samples, as observed
     for name, value in dict(I_xx=0.25, I_yy=0.33, omega0_x=W0[0], omega0_y=W0[1], omega0_z=W0[2]).items():
         assert abs(res.parameters[name] - value) < 4 * res.stderr[name], name
 
 
-def test_result_does_not_depend_on_the_unit_of_sigma():
-    rng = np.random.default_rng(7)
-    t = np.linspace(0.0, 8.0, 12)
-    q, _ = _motion(MOMENTS, t)
-    qn = _noisy_attitude(q, 2e-3, rng)
-    a = ep.fit(t, attitude=qn, attitude_sigma=2e-3)
+def test_result_does_not_depend_on_the_unit_of_sigma(dense_fits):
+    t, qn, a = dense_fits(12, 8.0)
     b = ep.fit(t, attitude=qn, attitude_sigma=1.0)  # every sigma x 500: the same least-squares problem
     assert b.chi2 == pytest.approx(a.chi2 / 500**2, rel=1e-6)
     assert np.abs(a.inertia - b.inertia).max() < 1e-8
@@ -1032,7 +1074,7 @@ def test_plots(noisy, axis_fit, plt, tmp_path):
 def test_plots_of_rates_only_and_full_tensor_fits(plt, tmp_path):
     t = np.linspace(0.0, 10.0, 21)
     q, w = _motion(MOMENTS, t)
-    rates = ep.fit(t, omega=_space(q, w), omega_sigma=1e-3, omega_frame="space")
+    rates = ep.fit(t, omega=_space(q, w), omega_sigma=1e-3, omega_frame="space", initial=START)
     paths = rates.save_plots(tmp_path)
     assert len(paths) == 3 and all(p.stat().st_size > 1000 for p in paths)
     spin = ep.fit(

@@ -173,8 +173,7 @@ MOTION_TORQUES = {
 }
 
 
-@pytest.fixture(scope="module")
-def motions():
+def _motions():
     out = {}
     for label, tq in MOTION_TORQUES.items():
         ref = ep.solve(I_GEN, T_EVAL, omega0=W0, attitude0=Q0, torque=tq, method="taylor", tol=1e-15)
@@ -188,6 +187,15 @@ def motions():
             sols[name] = sol.y.T
         out[label] = (ref, sols)
     return out
+
+
+@pytest.fixture(scope="module")
+def motions(tmp_path_factory):
+    """:func:`_motions`, computed once per test run (``once_per_run`` of tests/conftest.py): the tests that use
+    it may run on different pytest-xdist workers."""
+    from conftest import once_per_run
+
+    return once_per_run(tmp_path_factory, "test_formulations_potential-motions", _motions)
 
 
 @pytest.mark.parametrize("label", list(MOTION_TORQUES))
@@ -272,17 +280,17 @@ def D():
     return HT.derive_heavy_top("general")
 
 
-@pytest.mark.parametrize("name", HT.HeavyTopDerivation.IDENTITIES)
-def test_heavy_top_identity_exact(D, name):
-    assert D.identity(name) is True
-
-
-def test_heavy_top_identities_dict(D):
+# The checks of the general derivation that need its Legendre transform H and Hamilton's equations (most
+# of this file's time: D caches them) run in one test: split into several tests, each pytest-xdist worker
+# that ran one of them derived them again.
+def _check_identities_exact(D):
+    failed = [name for name in HT.HeavyTopDerivation.IDENTITIES if D.identity(name) is not True]
+    assert not failed, f"identities that do not hold exactly: {failed}"
     ids = D.identities()
     assert list(ids) == list(D.IDENTITIES) and all(ids.values())
 
 
-def test_heavy_top_wrong_sign_is_detected(D):
+def _check_wrong_sign_is_detected(D):
     # the exactness test is not vacuous: +2 A tau and -dH0/dn + dU/dn are not identities
     C = D.ctx
     tq = [sum((D._fA[i][j] * D._ftorque[j] for j in range(3)), C.const(0)) for i in range(3)]
@@ -290,26 +298,7 @@ def test_heavy_top_wrong_sign_is_detected(D):
     assert not D._zero([D._fpidot[i] + D._fH0.diff(D.n[i]) - D._fdU[i] for i in range(3)])
 
 
-def test_heavy_top_expressions(D):
-    import sympy as sp
-
-    # U, H symbols and shapes; H0 is the paper's eq. 1.15 with the corrected Atilde
-    assert D.U.free_symbols >= {D.mass, *D.c, *D.g}
-    assert D.vector_field.shape == (6, 1)
-    assert D.dU_dn.shape == D.torque.shape == D.pidot.shape == (3, 1)
-    n = sp.Matrix([sp.Rational(1, 3), sp.Rational(-1, 2), sp.Rational(1, 5)])
-    at0 = dict(zip(D.n, n))
-    s = 1 + (n.T * n)[0]
-    R = (
-        (1 - (n.T * n)[0]) * sp.eye(3)
-        + 2 * n * n.T
-        - 2 * sp.Matrix(3, 3, lambda i, j: sum(sp.LeviCivita(i, j, k) * n[k] for k in range(3)))
-    ) / s  # paper eq. 1.9
-    assert sp.simplify(D.R.xreplace(at0) - R) == sp.zeros(3, 3)
-    assert sp.expand(D.U.xreplace(at0) + D.mass * (D.g.T * R * D.c)[0]) == 0
-
-
-def test_heavy_top_matches_numeric_vector_field(D):
+def _check_matches_numeric_vector_field(D):
     rng = np.random.default_rng(17)
     for _ in range(4):
         n, pi, I, mass, c, g = HT._random_point(rng)
@@ -330,11 +319,43 @@ def test_heavy_top_matches_numeric_vector_field(D):
     tq = TORQUES["gravity"]
     d = D.evaluate(z[:3], z[3:], I_GEN, 1.3, tq.center_of_mass, tq.g)
     np.testing.assert_allclose(f.vector_field(z), d, rtol=1e-12, atol=1e-12)
-
-
-def test_check_heavy_top(D):  # D: skips without SymPy
+    # and check_heavy_top, the package's own comparison, without the identities
     res = HT.check_heavy_top(points=3, seed=1, identities=False)
     assert res.passed and res.points == 3 and res.max_difference < 1e-12 and res.identities == {}
+
+
+def _check_expressions(D):
+    import sympy as sp
+
+    # U, H symbols and shapes; H0 is the paper's eq. 1.15 with the corrected Atilde
+    assert D.U.free_symbols >= {D.mass, *D.c, *D.g}
+    assert D.vector_field.shape == (6, 1)
+    assert D.dU_dn.shape == D.torque.shape == D.pidot.shape == (3, 1)
+    n = sp.Matrix([sp.Rational(1, 3), sp.Rational(-1, 2), sp.Rational(1, 5)])
+    at0 = dict(zip(D.n, n))
+    s = 1 + (n.T * n)[0]
+    R = (
+        (1 - (n.T * n)[0]) * sp.eye(3)
+        + 2 * n * n.T
+        - 2 * sp.Matrix(3, 3, lambda i, j: sum(sp.LeviCivita(i, j, k) * n[k] for k in range(3)))
+    ) / s  # paper eq. 1.9
+    assert sp.simplify(D.R.xreplace(at0) - R) == sp.zeros(3, 3)
+    assert sp.expand(D.U.xreplace(at0) + D.mass * (D.g.T * R * D.c)[0]) == 0
+
+
+def test_heavy_top_general_derivation(D):
+    """Every identity of ``HeavyTopDerivation.IDENTITIES`` holds exactly (and ``identities()`` says so), a wrong
+    sign is detected, the expressions have their shapes and the paper's R and U, and the derived vector field
+    equals the numeric canonical formulation's."""
+    _check_identities_exact(D)
+    _check_wrong_sign_is_detected(D)
+    _check_expressions(D)
+    _check_matches_numeric_vector_field(D)
+
+
+def test_heavy_top_diagonal_and_errors(D):
+    # check_heavy_top with the identities of the diagonal derivation, whose H and Hamilton's equations the
+    # checks of dd below use too (one test: one worker derives them)
     res = HT.check_heavy_top(points=2, seed=2, inertia="diagonal")
     assert res.passed and res.max_difference < 1e-12
     assert list(res.identities) == list(HT.HeavyTopDerivation.IDENTITIES) and all(res.identities.values())
@@ -342,9 +363,6 @@ def test_check_heavy_top(D):  # D: skips without SymPy
         HT.check_heavy_top(points=0)
     with pytest.raises(TypeError, match="points"):
         HT.check_heavy_top(points=1.5)
-
-
-def test_heavy_top_diagonal_and_errors(D):
     dd = HT.derive_heavy_top("diagonal")
     assert HT.derive_heavy_top("diagonal") is dd
     assert dd.identity("dU_dn_is_minus_2A_tau") and dd.identity("pidot_closed_form")

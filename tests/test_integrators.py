@@ -88,9 +88,17 @@ FAST_W0 = 40.0 * np.array([0.3, 0.2, 0.93]) / np.linalg.norm([0.3, 0.2, 0.93])
 FAST_T = np.linspace(0.0, 10.0, 401)
 
 
+def _fast_reference_motion():
+    return reference_motion(I_ASYM, FAST_W0, np.array([1.0, 0, 0, 0]), FAST_T, rtol=1e-11, atol=1e-11)
+
+
 @pytest.fixture(scope="module")
-def fast_reference():
-    q_ref, w_ref = reference_motion(I_ASYM, FAST_W0, np.array([1.0, 0, 0, 0]), FAST_T, rtol=1e-11, atol=1e-11)
+def fast_reference(tmp_path_factory):
+    # computed once per test run (``once_per_run`` of tests/conftest.py): the tests that use it (one per
+    # method) may run on different pytest-xdist workers
+    from conftest import once_per_run
+
+    q_ref, w_ref = once_per_run(tmp_path_factory, "test_integrators-fast_reference", _fast_reference_motion)
     # the true motion passes through alpha = pi (w = 0) once per turn: 64 times here
     q_cont = q_ref * np.concatenate([[1.0], np.cumprod(np.sign(np.sum(q_ref[1:] * q_ref[:-1], -1)))])[:, None]
     assert np.sum(np.diff(np.sign(q_cont[:, 0])) != 0) >= 60

@@ -48,9 +48,10 @@ def _num(D, expr, n=None, ndot=None, pi=None, inertia=I_GEN, extra=None):
         )
     if extra:
         sub.update(extra)
-    syms = list(sub)
-    f = sp.lambdify(syms, expr, "numpy")
-    return np.array(f(*[sub[s] for s in syms]), dtype=float)
+    # the numbers substituted at 30 digits (no lambdify: printing and compiling each expression took longer
+    # than evaluating it)
+    value = sp.N(expr.xreplace({s: sp.Float(float(v), 30) for s, v in sub.items()}), 30)
+    return np.array(value.tolist() if isinstance(value, sp.MatrixBase) else value, dtype=float)
 
 
 def _R_numpy(n):
@@ -295,9 +296,15 @@ def test_lie_series_low_orders_exact(D):
     f = sp.Matrix.vstack(D.ndot_canonical, D.pidot_canonical)
     assert list(C.row(0)) == [0, 0, 0] + pi0
     assert list(C.row(1)) == [sp.nsimplify(x) for x in f.xreplace(at0)]
-    # second coefficient = 1/2 d/dt f = 1/2 (df/dz) f
+    # second coefficient = 1/2 d/dt f = 1/2 (df/dz) f, at z0: the derivative of f along the line
+    # z0 + s f(z0) at s = 0 (the chain rule; the same numbers as the full Jacobian, without its 36
+    # derivatives of the general-inertia expressions)
     z = list(D.n) + list(D.pi)
-    c2 = (f.jacobian(z) * f / 2).xreplace(at0)
+    z0 = [0, 0, 0] + pi0
+    f0 = list(f.xreplace(at0))
+    s = sp.Symbol("s")
+    line = {**rep, **{zi: z0i + s * fi for zi, z0i, fi in zip(z, z0, f0)}}
+    c2 = [sp.diff(x.xreplace(line), s).xreplace({s: 0}) / 2 for x in f]
     assert [sp.nsimplify(x) for x in C.row(2)] == [sp.nsimplify(sp.simplify(x)) for x in c2]
 
 

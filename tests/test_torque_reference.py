@@ -15,6 +15,9 @@ without any eulerpoisson code:
    space torque (L(t) = L0 + tau_s t), the gravity-gradient relative equilibrium.
 """
 
+import hashlib
+import math
+
 import mpmath
 import numpy as np
 import pytest
@@ -44,27 +47,42 @@ CASES = {
     "all": {"gravity": HEAVY, "gravity_gradient": NU, "body_torque": TAU_B, "space_torque": TAU_S},
 }
 
-_cache = {}
 
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """``run(name, ...)``: a memoised reference run (the mp version), so that one run serves several tests.
 
-def run(name, inertia=I_FULL, q0=Q0, w0=W0, t=TIMES, dps=40, order=None, **kw):
-    """Memoised reference run (the mp version), so that one run serves several tests."""
-    kw = dict(CASES[name], **kw) if name in CASES else kw
-    key = repr(
-        (
-            name,
-            dps,
-            order,
-            np.asarray(inertia).tolist(),
-            np.asarray(q0).tolist(),
-            np.asarray(w0).tolist(),
-            np.asarray(t).tolist(),
-            sorted((k, _plain(v)) for k, v in kw.items()),
+    Memoised for the whole test run (``once_per_run`` of tests/conftest.py), not only in this process: the
+    tests that share a run may go to different pytest-xdist workers, and the runs are most of this file's time.
+    """
+    from conftest import once_per_run
+
+    cache = {}
+
+    def run_(name, inertia=I_FULL, q0=Q0, w0=W0, t=TIMES, dps=40, order=None, **kw):
+        kw = dict(CASES[name], **kw) if name in CASES else kw
+        key = repr(
+            (
+                name,
+                dps,
+                order,
+                np.asarray(inertia).tolist(),
+                np.asarray(q0).tolist(),
+                np.asarray(w0).tolist(),
+                np.asarray(t).tolist(),
+                sorted((k, _plain(v)) for k, v in kw.items()),
+            )
         )
-    )
-    if key not in _cache:
-        _cache[key] = tr.reference_motion_mp(inertia, q0, w0, t, dps=dps, order=order, **kw)
-    return _cache[key]
+        if key not in cache:
+            label = "test_torque_reference-" + hashlib.sha256(key.encode()).hexdigest()[:20]
+            cache[key] = once_per_run(
+                tmp_path_factory,
+                label,
+                lambda: tr.reference_motion_mp(inertia, q0, w0, t, dps=dps, order=order, **kw),
+            )
+        return cache[key]
+
+    return run_
 
 
 def _plain(v):
@@ -94,48 +112,76 @@ def max_abs_diff(a, b):
 
 
 def _qmul(p, q):
+    """The Hamilton product of two 4-sequences of floats (a tuple: plain Python, see :func:`dop853`)."""
     pw, px, py, pz = p
     qw, qx, qy, qz = q
-    return np.array(
-        [
-            pw * qw - px * qx - py * qy - pz * qz,
-            pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx,
-            pw * qz + px * qy - py * qx + pz * qw,
-        ]
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
     )
 
 
 def _rot(q):
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
+    """R(q / |q|), rows as tuples."""
+    n = math.sqrt(sum(a * a for a in q))
+    w, x, y, z = (a / n for a in q)
+    return (
+        (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
+        (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
+        (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
     )
 
 
+def _mv(A, v):
+    return tuple(a[0] * v[0] + a[1] * v[1] + a[2] * v[2] for a in A)
+
+
+def _mtv(A, v):
+    """A^T v."""
+    return tuple(A[0][i] * v[0] + A[1][i] * v[1] + A[2][i] * v[2] for i in range(3))
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
 def dop853(inertia, q0, w0, t, gravity=None, gravity_gradient=None, body_torque=None, space_torque=None):
+    """scipy's DOP853 at rtol = atol = 1e-13 on q' = q (x) (0, W) / 2, I W' = (I W) x W + tau.
+
+    The right-hand side is written in plain Python floats: NumPy's overhead on 3-vectors made it
+    several times slower, and it is called some 10^4 times per run.
+    """
     I = np.diag(inertia) if np.ndim(inertia) == 1 else np.asarray(inertia, float)
     Iinv = np.linalg.inv(I)
+    I_, Iinv_ = tuple(map(tuple, I.tolist())), tuple(map(tuple, Iinv.tolist()))
+    grav = [
+        (float(m), tuple(np.asarray(c, float).tolist()), tuple(np.asarray(g, float).tolist()))
+        for m, c, g in gravity or []
+    ]
+    tau_b = None if body_torque is None else tuple(np.asarray(body_torque, float).tolist())
+    tau_s = None if space_torque is None else tuple(np.asarray(space_torque, float).tolist())
 
     def f(s, y):
-        q, w = y[:4], y[4:]
+        qw, qx, qy, qz, w1, w2, w3 = y.tolist()
+        q, w = (qw, qx, qy, qz), (w1, w2, w3)
         R = _rot(q)
-        tau = np.zeros(3)
-        for m, c, g in gravity or []:
-            tau += np.cross(c, m * R.T @ g)
+        tau = [0.0, 0.0, 0.0]
+        for m, c, g in grav:
+            gb = _mtv(R, g)
+            tau = [a + b for a, b in zip(tau, _cross(c, (m * gb[0], m * gb[1], m * gb[2])))]
         if gravity_gradient is not None:
             nu = gravity_gradient
-            rb = R.T @ np.array([np.cos(nu * s), np.sin(nu * s), 0.0])
-            tau += 3 * nu**2 * np.cross(rb, I @ rb)
-        if body_torque is not None:
-            tau += body_torque
-        if space_torque is not None:
-            tau += R.T @ space_torque
-        return np.concatenate([0.5 * _qmul(q, np.concatenate([[0.0], w])), Iinv @ (np.cross(I @ w, w) + tau)])
+            rb = _mtv(R, (math.cos(nu * s), math.sin(nu * s), 0.0))
+            tau = [a + 3 * nu**2 * b for a, b in zip(tau, _cross(rb, _mv(I_, rb)))]
+        if tau_b is not None:
+            tau = [a + b for a, b in zip(tau, tau_b)]
+        if tau_s is not None:
+            tau = [a + b for a, b in zip(tau, _mtv(R, tau_s))]
+        qd = _qmul(q, (0.0, w1, w2, w3))
+        rhs = [a + b for a, b in zip(_cross(_mv(I_, w), w), tau)]
+        return [0.5 * qd[0], 0.5 * qd[1], 0.5 * qd[2], 0.5 * qd[3], *_mv(Iinv_, rhs)]
 
     sol = solve_ivp(f, (0.0, t[-1]), np.concatenate([q0, w0]), method="DOP853", t_eval=t, rtol=1e-13, atol=1e-13)
     assert sol.success
@@ -146,7 +192,7 @@ def dop853(inertia, q0, w0, t, gravity=None, gravity_gradient=None, body_torque=
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_agrees_with_dop853(name):
+def test_agrees_with_dop853(name, run):
     q, w = run(name)
     qd, wd = dop853(I_FULL, Q0, W0, TIMES, **CASES[name])
     q, w = as_float(q), as_float(w)
@@ -154,7 +200,7 @@ def test_agrees_with_dop853(name):
     assert np.max(np.abs(q - qd)) < 1e-10
 
 
-def test_float_api_matches_mp_api_and_handles_time_order():
+def test_float_api_matches_mp_api_and_handles_time_order(run):
     t = np.array([7.5, 0.0, 2.5, 7.5, 10.0])  # unsorted, with a repeat and t = 0
     q, w = tr.reference_motion(I_FULL, Q0, W0, t, gravity=HEAVY)
     assert q.shape == (5, 4) and w.shape == (5, 3) and q.dtype == np.float64
@@ -175,18 +221,18 @@ def test_float_api_matches_mp_api_and_handles_time_order():
 
 
 @pytest.mark.parametrize("name", ["free", "gravity", "two_gravities"])
-def test_energy_conserved(name):
+def test_energy_conserved(name, run):
     q, w = run(name)
     assert max_rel_drift(tr.energy(I_FULL, q, w, CASES[name].get("gravity"))) < 1e-25
 
 
-def test_energy_is_not_conserved_with_the_wrong_potential_sign():
+def test_energy_is_not_conserved_with_the_wrong_potential_sign(run):
     q, w = run("gravity")
     flipped = [(-m, c, g) for m, c, g in HEAVY]
     assert max_rel_drift(tr.energy(I_FULL, q, w, flipped)) > 1e-3
 
 
-def test_vertical_momentum_and_area_conserved():
+def test_vertical_momentum_and_area_conserved(run):
     q, w = run("gravity")
     v = tr.vertical_momentum(I_FULL, q, w, G)
     a = tr.area_integral(I_FULL, q, w, G)
@@ -195,7 +241,7 @@ def test_vertical_momentum_and_area_conserved():
         assert max(abs(x + y) for x, y in zip(v, a)) < 1e-40
 
 
-def test_space_angular_momentum_free_and_under_space_torque():
+def test_space_angular_momentum_free_and_under_space_torque(run):
     q, w = run("free")
     L = tr.space_angular_momentum(I_FULL, q, w)
     assert max_abs_diff(L, [L[0]] * len(L)) < 1e-25 * float(mpmath.norm(mpmath.matrix(L[0])))
@@ -207,14 +253,14 @@ def test_space_angular_momentum_free_and_under_space_torque():
     assert max_abs_diff(L, pred) < 1e-25
 
 
-def test_unit_quaternion_conserved():
+def test_unit_quaternion_conserved(run):
     for name in CASES:
         q, _ = run(name)
         with mpmath.workdps(60):
             assert max(abs(sum(a * a for a in qq) - 1) for qq in q) < 1e-40
 
 
-def test_lagrange_top():
+def test_lagrange_top(run):
     I = np.array([1.5, 1.5, 0.8])
     grav = [(1.3, np.array([0.0, 0.0, 0.6]), G)]
     w0 = np.array([0.7, -1.1, 4.3])
@@ -226,7 +272,7 @@ def test_lagrange_top():
 
 
 @pytest.mark.parametrize("c", [(0.4, 0.0, 0.0), (0.25, -0.3, 0.0)])
-def test_kovalevskaya(c):
+def test_kovalevskaya(c, run):
     c = np.array(c)
     I = np.array([2.0, 2.0, 1.0]) * 0.7
     grav = [(1.3, c, G)]
@@ -260,7 +306,7 @@ def _gc_initial(c_y):
 
 
 @pytest.mark.parametrize("c_y", [0.0, -0.3])
-def test_goryachev_chaplygin_on_zero_area(c_y):
+def test_goryachev_chaplygin_on_zero_area(c_y, run):
     I = np.array([4.0, 4.0, 1.0]) * 0.7
     q0, w0, c = _gc_initial(c_y)
     grav = [(1.3, c, G)]
@@ -274,7 +320,7 @@ def test_goryachev_chaplygin_on_zero_area(c_y):
     assert abs(float(w[-1][2])) > 1e-2  # a non-trivial motion
 
 
-def test_goryachev_chaplygin_needs_zero_area():
+def test_goryachev_chaplygin_needs_zero_area(run):
     I = np.array([4.0, 4.0, 1.0]) * 0.7
     c = np.array([0.4, 0.0, 0.0])
     grav = [(1.3, c, G)]
@@ -302,7 +348,7 @@ def test_goryachev_chaplygin_derivative_off_zero_area():
         assert abs(num - pred) < 1e-15 * abs(pred)
 
 
-def test_jacobi_integral_gravity_gradient():
+def test_jacobi_integral_gravity_gradient(run):
     q, w = run("gravity_gradient")
     J = tr.jacobi_integral(I_FULL, q, w, NU, TIMES)
     assert max_rel_drift(J) < 1e-25
@@ -318,7 +364,7 @@ def test_jacobi_integral_gravity_gradient():
 
 
 @pytest.mark.parametrize("name", ["free", "all"])
-def test_precisions_and_step_controls_agree(name):
+def test_precisions_and_step_controls_agree(name, run):
     q40, w40 = run(name)
     q30, w30 = run(name, dps=30)
     q45, w45 = run(name, dps=45)
@@ -362,7 +408,7 @@ def _qmul_mp(p, q):
     ]
 
 
-def test_free_symmetric_top_closed_form():
+def test_free_symmetric_top_closed_form(run):
     I = np.array([2.0, 2.0, 0.75])
     q, w = run("free", inertia=I)
     with mpmath.workdps(50):

@@ -5,6 +5,7 @@ digits that shares no code with eulerpoisson (its own torque formulas,
 recurrences and integrals).
 """
 
+import functools
 import math
 
 import numpy as np
@@ -50,15 +51,28 @@ CASES = {
     "space_torque": (I_FULL, Q0, W0, SpaceTorque([0.3, -0.1, 0.2]), dict(space_torque=[0.3, -0.1, 0.2])),
 }
 
-_REF_CACHE = {}
 
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """``reference(name, t_end=10.0)``: the high-precision reference of ``CASES[name]`` at ``t_end``, memoised for
+    the whole test run (``once_per_run`` of tests/conftest.py): the tests that share one may run on different
+    pytest-xdist workers."""
+    from conftest import once_per_run
 
-def _reference(name, t_end=10.0):
-    key = (name, t_end)
-    if key not in _REF_CACHE:
-        inertia, q0, w0, _, ref = CASES[name]
-        _REF_CACHE[key] = reference_motion(inertia, q0, w0, [t_end], **ref)
-    return _REF_CACHE[key]
+    cache = {}
+
+    def reference_(name, t_end=10.0):
+        key = (name, t_end)
+        if key not in cache:
+            inertia, q0, w0, _, ref = CASES[name]
+            cache[key] = once_per_run(
+                tmp_path_factory,
+                f"test_torques-reference-{name}-{t_end!r}",
+                lambda: reference_motion(inertia, q0, w0, [t_end], **ref),
+            )
+        return cache[key]
+
+    return reference_
 
 
 def _errors(tr, qr, wr):
@@ -68,18 +82,18 @@ def _errors(tr, qr, wr):
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_taylor_agrees_with_high_precision_reference_at_t10(name):
+def test_taylor_agrees_with_high_precision_reference_at_t10(name, reference):
     inertia, q0, w0, torque, _ = CASES[name]
-    qr, wr = _reference(name)
+    qr, wr = reference(name)
     tr = ep.solve(inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="taylor", tol=1e-15)
     dq, dw = _errors(tr, qr, wr)
     assert dq <= 1e-12 and dw <= 1e-12, (name, dq, dw)
 
 
 @pytest.mark.parametrize("name", list(CASES))
-def test_rk_dop853_agrees_with_reference_at_t10(name):
+def test_rk_dop853_agrees_with_reference_at_t10(name, reference):
     inertia, q0, w0, torque, _ = CASES[name]
-    qr, wr = _reference(name)
+    qr, wr = reference(name)
     tr = ep.solve(
         inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", integrator="DOP853", tol=1e-13
     )
@@ -88,10 +102,10 @@ def test_rk_dop853_agrees_with_reference_at_t10(name):
 
 
 @pytest.mark.parametrize("name", ["lagrange", "gravity_gradient", "space_torque"])
-def test_rk_gibbs_charts_see_the_full_attitude(name):
+def test_rk_gibbs_charts_see_the_full_attitude(name, reference):
     """In charts R = R_c R(n) the torque must use R_c too (no left invariance under torque)."""
     inertia, q0, w0, torque, _ = CASES[name]
-    qr, wr = _reference(name)
+    qr, wr = reference(name)
     tr = ep.solve(inertia, [10.0], omega0=w0, attitude0=q0, torque=torque, method="rk", formulation="gibbs", tol=1e-13)
     assert tr.stats["chart_changes"] > 0
     dq, dw = _errors(tr, qr, wr)
@@ -100,10 +114,10 @@ def test_rk_gibbs_charts_see_the_full_attitude(name):
 
 @pytest.mark.parametrize("scheme,order", [("exact_splitting", 2), ("exact_splitting4", 4)])
 @pytest.mark.parametrize("name", ["asymmetric_full_tensor", "gravity_gradient", "space_torque"])
-def test_exact_splitting_converges_at_its_order(name, scheme, order):
+def test_exact_splitting_converges_at_its_order(name, scheme, order, reference):
     inertia, q0, w0, torque, _ = CASES[name]
     t_end = 2.0
-    qr, wr = _reference(name, t_end)
+    qr, wr = reference(name, t_end)
     errs = []
     for dt in (0.02, 0.01, 0.005):
         tr = ep.solve(
@@ -233,13 +247,23 @@ TORQUES = {
 }
 
 
+def _every_torque_problem(tname):
+    """(torque, inertia, omega0) of :func:`test_every_method_handles_or_refuses_every_torque`."""
+    return TORQUES[tname], ([1.0, 1.0, 0.5] if tname == "gravity" else [1.0, 1.5, 0.8]), [0.2, 0.1, 3.0]
+
+
+@functools.cache
+def _every_torque_rk_reference(tname):
+    """The attitude at t = 1 by rk at tol = 1e-12: once per torque, not once per method."""
+    torque, inertia, w0 = _every_torque_problem(tname)
+    return ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method="rk", tol=1e-12).quaternion[-1].copy()
+
+
 @pytest.mark.parametrize("method", available_methods())
 @pytest.mark.parametrize("tname", list(TORQUES))
 def test_every_method_handles_or_refuses_every_torque(method, tname):
     """Each method x torque pair either runs (and agrees with rk) or refuses by a clear error naming the able."""
-    torque = TORQUES[tname]
-    inertia = [1.0, 1.0, 0.5] if tname == "gravity" else [1.0, 1.5, 0.8]
-    w0 = [0.2, 0.1, 3.0]
+    torque, inertia, w0 = _every_torque_problem(tname)
     model = ep.Model(inertia, torque)
     reason = get_method(method).supports(model)
     if reason is not None:
@@ -249,9 +273,8 @@ def test_every_method_handles_or_refuses_every_torque(method, tname):
             ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method=method)
         return
     tr = ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method=method)
-    ref = ep.solve(inertia, [0.0, 1.0], omega0=w0, torque=torque, method="rk", tol=1e-12)
     tol = 1e-5 if method == "symplectic" else 1e-9
-    assert quaternion_distance(tr.quaternion[-1], ref.quaternion[-1]) < tol
+    assert quaternion_distance(tr.quaternion[-1], _every_torque_rk_reference(tname)) < tol
     assert method in methods_supporting(model)
 
 
@@ -346,7 +369,7 @@ def test_compose_initial_refuses_models_with_torque():
         compose_initial(p, np.zeros((1, 4)))
 
 
-def test_exact_lagrange_top_in_any_body_frame_agrees_with_reference_at_t10():
+def test_exact_lagrange_top_in_any_body_frame_agrees_with_reference_at_t10(reference):
     """The symmetry axis along a rotated direction of a full tensor: recognized, solved in closed form."""
     R0 = ep.Attitude.from_rotvec([0.3, -0.5, 0.2]).as_matrix()
     inertia = R0 @ np.diag([0.5, 1.0, 1.0]) @ R0.T
@@ -360,7 +383,7 @@ def test_exact_lagrange_top_in_any_body_frame_agrees_with_reference_at_t10():
     assert dq <= 1e-12 and dw <= 1e-12, (dq, dw)
     assert tr.stats["model"] == "lagrange top"
     inertia, q0, w0, torque, _ = CASES["lagrange"]
-    qr, wr = _reference("lagrange")
+    qr, wr = reference("lagrange")
     tr = ep.solve(inertia, [0.0, 10.0], omega0=w0, attitude0=q0, torque=torque, method="exact")
     dq, dw = _errors(tr, qr, wr)
     assert dq <= 1e-12 and dw <= 1e-12, (dq, dw)
@@ -382,12 +405,12 @@ def test_exact_lagrange_batches_equal_one_by_one_and_other_tops_are_refused():
 
 
 @pytest.mark.parametrize("name", [m for m in available_methods() if get_method(m).refine])
-def test_observed_order_under_torque_matches_nominal(name):
+def test_observed_order_under_torque_matches_nominal(name, reference):
     """Registry-driven: each method's accuracy knob on the heavy asymmetric top (the same rule as for the free body)."""
     cls = get_method(name)
     inertia, q0, w0, torque, _ = CASES["asymmetric_full_tensor"]
     t_end = 2.0
-    qr, wr = _reference("asymmetric_full_tensor", t_end)
+    qr, wr = reference("asymmetric_full_tensor", t_end)
 
     def err(**opts):
         tr = ep.solve(inertia, [t_end], omega0=w0, attitude0=q0, torque=torque, method=name, **opts)

@@ -27,11 +27,26 @@ def reference_motion(inertia, omega0, q0, t, rtol=1e-13, atol=1e-13):
     if I.ndim == 1:
         I = np.diag(I)
     Iinv = np.linalg.inv(I)
+    (a, b, c), (d, e, g), (h, k, m) = I.tolist()
+    (ia, ib, ic), (id_, ie, ig), (ih, ik, im) = Iinv.tolist()
 
     def f(_, y):
-        q, w = y[:4], y[4:]
-        M = I @ w
-        return np.concatenate([0.5 * _qmul(q, np.concatenate([[0.0], w])), Iinv @ np.cross(M, w)])
+        # in plain floats (about 5x faster than with NumPy's small-array calls): M = I w, I dw/dt = M x w,
+        # dq/dt = q (x) (0, w) / 2
+        qw, qx, qy, qz, w0, w1, w2 = y.tolist()
+        M0, M1, M2 = a * w0 + b * w1 + c * w2, d * w0 + e * w1 + g * w2, h * w0 + k * w1 + m * w2
+        c0, c1, c2 = M1 * w2 - M2 * w1, M2 * w0 - M0 * w2, M0 * w1 - M1 * w0
+        return np.array(
+            [
+                0.5 * (-qx * w0 - qy * w1 - qz * w2),
+                0.5 * (qw * w0 + qy * w2 - qz * w1),
+                0.5 * (qw * w1 - qx * w2 + qz * w0),
+                0.5 * (qw * w2 + qx * w1 - qy * w0),
+                ia * c0 + ib * c1 + ic * c2,
+                id_ * c0 + ie * c1 + ig * c2,
+                ih * c0 + ik * c1 + im * c2,
+            ]
+        )
 
     t = np.asarray(t, float)
     y0 = np.concatenate([q0, omega0])

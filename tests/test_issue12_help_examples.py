@@ -12,6 +12,11 @@ paper's audit is one equation (the whole audit is tested in test_audit.py).
 
 No example may reach a network: a remote Dask scheduler (``tcp://...``) is
 named in the prose of ``sweep --help``, never as an example.
+
+This is the one test that runs the help examples (once per test run): the tests of ``simulate``, ``plot``,
+``info``, ``animate`` (tests/test_cli_torque.py, tests/test_cli_parity.py), ``validate`` and ``cases``
+(tests/test_oracle.py) check that their command's help shows the examples run here, and the files those
+examples write are checked here.
 """
 
 import argparse
@@ -143,6 +148,7 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
         "audit/audit.json",
         "audit/audit.tex",
         "plot/polhode.pdf",
+        "plot/apex.png",
         "animate/movie.gif",
         "sweep/atlas.zarr",
         "sweep/atlas.png",
@@ -153,4 +159,5 @@ def test_every_help_example_runs(capsys, tmp_path, monkeypatch):
         "cases/cases_csv/sphere.csv",
     ):
         assert (tmp_path / f).exists(), f
+    assert not (tmp_path / "cases" / "cases_csv" / "sphere.nc").exists()  # --csv-only
     assert ep.Trajectory.open(tmp_path / "base" / "top.nc").model.lagrange_top() is not None

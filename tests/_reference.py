@@ -17,6 +17,19 @@ def _qmul(p, q):
     )
 
 
+def qmul_floats(p, q):
+    """The Hamilton product of two 4-sequences of floats, as a tuple (plain Python: for right-hand sides that
+    scipy calls many times, where NumPy's small-array calls cost more than the arithmetic)."""
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    )
+
+
 def reference_motion(inertia, omega0, q0, t, rtol=1e-13, atol=1e-13):
     """Euler's equations I dW/dt = (I W) x W and dq/dt = q (x) (0, W)/2 by DOP853.
 

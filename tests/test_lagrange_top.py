@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from _reference import qmul_floats
 from eulerpoisson.solvers.exact.lagrange import lagrange_top_motion
 
 G = [0.0, 0.0, -9.81]
@@ -99,18 +100,6 @@ def _qmul(a, b):
     )
 
 
-def _qmul_scalar(a, b):
-    """The Hamilton product of two 4-tuples of floats (plain Python: the DOP853 right-hand side calls it often)."""
-    aw, ax, ay, az = a
-    bw, bx, by, bz = b
-    return (
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    )
-
-
 def _rhs(t, y, A, C, mass, ell, g):
     """q' = q (x) (0, Omega) / 2, I Omega' = (I Omega) x Omega + (0, 0, ell) x (mass R^T g), I = diag(A, A, C).
 
@@ -119,9 +108,9 @@ def _rhs(t, y, A, C, mass, ell, g):
     """
     qw, qx, qy, qz, o1, o2, o3 = y.tolist()
     q = (qw, qx, qy, qz)
-    _, gb1, gb2, _ = _qmul_scalar(_qmul_scalar((qw, -qx, -qy, -qz), (0.0, *g)), q)  # R^T g
+    _, gb1, gb2, _ = qmul_floats(qmul_floats((qw, -qx, -qy, -qz), (0.0, *g)), q)  # R^T g
     a1, a2, a3 = A * o1, A * o2, C * o3  # I Omega
-    qd = _qmul_scalar(q, (0.0, o1, o2, o3))
+    qd = qmul_floats(q, (0.0, o1, o2, o3))
     return [
         0.5 * qd[0],
         0.5 * qd[1],

@@ -24,6 +24,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import _torque_reference as tr
+from _reference import qmul_floats
 
 T_END = 10.0
 TIMES = np.array([0.0, 2.5, 5.0, 7.5, T_END])
@@ -111,18 +112,6 @@ def max_abs_diff(a, b):
 # ----------------------------------------------------------------------------- scipy DOP853, written here
 
 
-def _qmul(p, q):
-    """The Hamilton product of two 4-sequences of floats (a tuple: plain Python, see :func:`dop853`)."""
-    pw, px, py, pz = p
-    qw, qx, qy, qz = q
-    return (
-        pw * qw - px * qx - py * qy - pz * qz,
-        pw * qx + px * qw + py * qz - pz * qy,
-        pw * qy - px * qz + py * qw + pz * qx,
-        pw * qz + px * qy - py * qx + pz * qw,
-    )
-
-
 def _rot(q):
     """R(q / |q|), rows as tuples."""
     n = math.sqrt(sum(a * a for a in q))
@@ -179,7 +168,7 @@ def dop853(inertia, q0, w0, t, gravity=None, gravity_gradient=None, body_torque=
             tau = [a + b for a, b in zip(tau, tau_b)]
         if tau_s is not None:
             tau = [a + b for a, b in zip(tau, _mtv(R, tau_s))]
-        qd = _qmul(q, (0.0, w1, w2, w3))
+        qd = qmul_floats(q, (0.0, w1, w2, w3))
         rhs = [a + b for a, b in zip(_cross(_mv(I_, w), w), tau)]
         return [0.5 * qd[0], 0.5 * qd[1], 0.5 * qd[2], 0.5 * qd[3], *_mv(Iinv_, rhs)]
 

@@ -2,13 +2,9 @@
 
 References are independent integrations of the Euler-Poisson equations in the
 ``(q, Omega)`` variables: scipy's DOP853 at ``rtol = atol = 1e-13`` (agreement
-``<= 1e-10``) and, for the round-off claim, a fixed-order Taylor method at 34
-digits (agreement ``<= 1e-13`` at ``t = 10``), in binary fixed point on Python
-integers.
+``<= 1e-10``) and, for the round-off claim, the Taylor integrator of
+tests/_torque_reference.py at 34 digits (agreement ``<= 1e-13`` at ``t = 10``).
 """
-
-import math
-from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -16,6 +12,9 @@ from scipy.integrate import solve_ivp
 
 from _reference import qmul_floats
 from eulerpoisson.solvers.exact.lagrange import lagrange_top_motion
+
+pytest.importorskip("mpmath")
+import _torque_reference as tr  # noqa: E402
 
 G = [0.0, 0.0, -9.81]
 _TH = 1e-9  # tilt of the "near the vertical" cases
@@ -147,79 +146,15 @@ def _dop853(case, t):
     return out[:, :4], out[:, 4:]
 
 
-def _mp_taylor(case, t_end, dps=34, order=24, h=0.1):
-    """Fixed-order Taylor integration of (q, Omega) at ``dps`` digits (degree-2 polynomial ODE).
-
-    Binary fixed point on Python integers (value = n / 2**P, ``P = ceil(dps log2 10) + 64`` bits, the
-    technique of mpmath's own series and of tests/_torque_reference.py): 7x faster than ``mpf`` objects,
-    with an absolute round-off of 2**-P per operation (the results equal those of the former mpf code
-    after rounding to float64).
-    """
+def _mp_taylor(case, t_end, dps=34):
+    """The motion at ``t_end`` by tests/_torque_reference.py's Taylor integrator at ``dps`` digits (any sign of
+    ``t_end``: (q(-t), -Omega(-t)) is the motion from (q0, -Omega0), the equations being even in Omega)."""
     A, C, mass, ell, g, q0, om0 = case
-    P = math.ceil(dps * math.log2(10)) + 64
-    one = 1 << P
-
-    def fix(x):  # a float, exactly, rounded to P fractional bits
-        return round(Fraction(float(x)) * one)
-
-    def mul(a, b):
-        return (a * b) >> P
-
-    def div(a, b):
-        return (a << P) // b
-
-    def cp(a, b, k):  # the k-th coefficient of the Cauchy product of two series
-        return sum(x * y for x, y in zip(a[: k + 1], b[k::-1])) >> P
-
-    A, C, mass, ell = (fix(v) for v in (A, C, mass, ell))
-    g1, g2, g3 = (fix(v) for v in g)
-    q = [fix(v) for v in q0]
-    nq = math.isqrt(sum(v * v for v in q))  # |q0| 2**P
-    q = [(v << P) // nq for v in q]
-    w = [fix(v) for v in om0]
-    n = math.ceil(abs(t_end) / h)
-    hh = round(Fraction(t_end) / n * one)
-    em = mul(ell, mass)
-    for _ in range(n):
-        Q = [[v] for v in q]
-        W = [[v] for v in w]
-        Gs = [[] for _ in range(4)]  # the series of (0, g) (x) q
-        for k in range(order):
-            qd = [
-                -(cp(Q[1], W[0], k) + cp(Q[2], W[1], k) + cp(Q[3], W[2], k)),
-                cp(Q[0], W[0], k) + cp(Q[2], W[2], k) - cp(Q[3], W[1], k),
-                cp(Q[0], W[1], k) - cp(Q[1], W[2], k) + cp(Q[3], W[0], k),
-                cp(Q[0], W[2], k) + cp(Q[1], W[1], k) - cp(Q[2], W[0], k),
-            ]
-            qk = [Q[j][k] for j in range(4)]
-            Gk = [
-                (-g1 * qk[1] - g2 * qk[2] - g3 * qk[3]) >> P,
-                (g1 * qk[0] + g2 * qk[3] - g3 * qk[2]) >> P,
-                (-g1 * qk[3] + g2 * qk[0] + g3 * qk[1]) >> P,
-                (g1 * qk[2] - g2 * qk[1] + g3 * qk[0]) >> P,
-            ]
-            for j in range(4):
-                Gs[j].append(Gk[j])
-            qc = [Q[0], [-v for v in Q[1]], [-v for v in Q[2]], [-v for v in Q[3]]]
-            gb0 = cp(qc[0], Gs[1], k) + cp(qc[1], Gs[0], k) + cp(qc[2], Gs[3], k) - cp(qc[3], Gs[2], k)
-            gb1 = cp(qc[0], Gs[2], k) - cp(qc[1], Gs[3], k) + cp(qc[2], Gs[0], k) + cp(qc[3], Gs[1], k)
-            d0 = div(mul(A - C, cp(W[1], W[2], k)) - mul(em, gb1), A)
-            d1 = div(mul(C - A, cp(W[0], W[2], k)) + mul(em, gb0), A)
-            for j in range(4):
-                Q[j].append(qd[j] // (2 * (k + 1)))
-            W[0].append(d0 // (k + 1))
-            W[1].append(d1 // (k + 1))
-            W[2].append(0)
-
-        def ev(c):
-            s = 0
-            for v in reversed(c):
-                s = ((s * hh) >> P) + v
-            return s
-
-        q = [ev(c) for c in Q]
-        w = [ev(c) for c in W]
-    return np.array([v / one for v in q]), np.array([v / one for v in w])
+    s = 1.0 if t_end >= 0 else -1.0
+    q, om = tr.reference_motion(
+        [A, A, C], q0, s * np.asarray(om0, float), [abs(t_end)], gravity=(mass, (0.0, 0.0, ell), g), dps=dps
+    )
+    return q[0], s * om[0]
 
 
 def _qdist(q, qr):

@@ -185,6 +185,13 @@ def once_per_run(tmp_path_factory, name: str, compute):
 
 
 @pytest.fixture(scope="session")
+def run_once(tmp_path_factory):
+    """``run_once(name, compute)``: :func:`once_per_run` for a test module's expensive, deterministic references
+    (``name`` unique in the run, e.g. ``"<module>-<what>"``), which tests on different pytest-xdist workers share."""
+    return lambda name, compute: once_per_run(tmp_path_factory, name, compute)
+
+
+@pytest.fixture(scope="session")
 def audit_report_once(tmp_path_factory):
     """A function returning a copy of ``run_audit()`` (the paper's whole audit, about 45 s of CPU), computed once.
 

@@ -190,12 +190,10 @@ def _motions():
 
 
 @pytest.fixture(scope="module")
-def motions(tmp_path_factory):
-    """:func:`_motions`, computed once per test run (``once_per_run`` of tests/conftest.py): the tests that use
-    it may run on different pytest-xdist workers."""
-    from conftest import once_per_run
-
-    return once_per_run(tmp_path_factory, "test_formulations_potential-motions", _motions)
+def motions(run_once):
+    """:func:`_motions`, computed once per test run (``run_once`` of tests/conftest.py): the tests that use it
+    may run on different pytest-xdist workers."""
+    return run_once("test_formulations_potential-motions", _motions)
 
 
 @pytest.mark.parametrize("label", list(MOTION_TORQUES))

@@ -93,12 +93,10 @@ def _fast_reference_motion():
 
 
 @pytest.fixture(scope="module")
-def fast_reference(tmp_path_factory):
-    # computed once per test run (``once_per_run`` of tests/conftest.py): the tests that use it (one per
-    # method) may run on different pytest-xdist workers
-    from conftest import once_per_run
-
-    q_ref, w_ref = once_per_run(tmp_path_factory, "test_integrators-fast_reference", _fast_reference_motion)
+def fast_reference(run_once):
+    # computed once per test run (``run_once`` of tests/conftest.py): the tests that use it (one per method) may
+    # run on different pytest-xdist workers
+    q_ref, w_ref = run_once("test_integrators-fast_reference", _fast_reference_motion)
     # the true motion passes through alpha = pi (w = 0) once per turn: 64 times here
     q_cont = q_ref * np.concatenate([[1.0], np.cumprod(np.sign(np.sum(q_ref[1:] * q_ref[:-1], -1)))])[:, None]
     assert np.sum(np.diff(np.sign(q_cont[:, 0])) != 0) >= 60

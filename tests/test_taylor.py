@@ -298,13 +298,11 @@ def _mp_truth():
 
 
 @pytest.fixture(scope="module")
-def mp_truth(tmp_path_factory):
-    """:func:`_mp_truth`, computed once per test run (``once_per_run`` of tests/conftest.py): the two tests
-    that use it may run on different pytest-xdist workers, and it is most of their cost."""
+def mp_truth(run_once):
+    """:func:`_mp_truth`, computed once per test run (``run_once`` of tests/conftest.py): the two tests that use
+    it may run on different pytest-xdist workers, and it is most of their cost."""
     pytest.importorskip("mpmath")
-    from conftest import once_per_run
-
-    return once_per_run(tmp_path_factory, "test_taylor-mp_truth", _mp_truth)
+    return run_once("test_taylor-mp_truth", _mp_truth)
 
 
 def test_mpmath_integration_converges_to_30_digits(mp_truth):

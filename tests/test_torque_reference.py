@@ -50,15 +50,12 @@ CASES = {
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(run_once):
     """``run(name, ...)``: a memoised reference run (the mp version), so that one run serves several tests.
 
-    Memoised for the whole test run (``once_per_run`` of tests/conftest.py), not only in this process: the
-    tests that share a run may go to different pytest-xdist workers, and the runs are most of this file's time.
+    Memoised for the whole test run (``run_once`` of tests/conftest.py), not only in this process: the tests
+    that share a run may go to different pytest-xdist workers, and the runs are most of this file's time.
     """
-    from conftest import once_per_run
-
-    cache = {}
 
     def run_(name, inertia=I_FULL, q0=Q0, w0=W0, t=TIMES, dps=40, order=None, **kw):
         kw = dict(CASES[name], **kw) if name in CASES else kw
@@ -74,14 +71,8 @@ def run(tmp_path_factory):
                 sorted((k, _plain(v)) for k, v in kw.items()),
             )
         )
-        if key not in cache:
-            label = "test_torque_reference-" + hashlib.sha256(key.encode()).hexdigest()[:20]
-            cache[key] = once_per_run(
-                tmp_path_factory,
-                label,
-                lambda: tr.reference_motion_mp(inertia, q0, w0, t, dps=dps, order=order, **kw),
-            )
-        return cache[key]
+        label = "test_torque_reference-" + hashlib.sha256(key.encode()).hexdigest()[:20]
+        return run_once(label, lambda: tr.reference_motion_mp(inertia, q0, w0, t, dps=dps, order=order, **kw))
 
     return run_
 

@@ -53,24 +53,16 @@ CASES = {
 
 
 @pytest.fixture(scope="module")
-def reference(tmp_path_factory):
+def reference(run_once):
     """``reference(name, t_end=10.0)``: the high-precision reference of ``CASES[name]`` at ``t_end``, memoised for
-    the whole test run (``once_per_run`` of tests/conftest.py): the tests that share one may run on different
+    the whole test run (``run_once`` of tests/conftest.py): the tests that share one may run on different
     pytest-xdist workers."""
-    from conftest import once_per_run
-
-    cache = {}
 
     def reference_(name, t_end=10.0):
-        key = (name, t_end)
-        if key not in cache:
-            inertia, q0, w0, _, ref = CASES[name]
-            cache[key] = once_per_run(
-                tmp_path_factory,
-                f"test_torques-reference-{name}-{t_end!r}",
-                lambda: reference_motion(inertia, q0, w0, [t_end], **ref),
-            )
-        return cache[key]
+        inertia, q0, w0, _, ref = CASES[name]
+        return run_once(
+            f"test_torques-reference-{name}-{t_end!r}", lambda: reference_motion(inertia, q0, w0, [t_end], **ref)
+        )
 
     return reference_
 

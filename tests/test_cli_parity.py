@@ -235,14 +235,3 @@ def test_a_file_whose_times_are_all_equal_is_refused(tmp_path):
     ds.to_netcdf(tmp_path / "b.nc", engine="h5netcdf")
     with pytest.raises(ep.InvalidInputError, match="b.nc: the time variable holds the same value 0.0 for all 3"):
         ep.Trajectory.from_netcdf(tmp_path / "b.nc")
-
-
-def test_the_help_examples_of_info_and_animate_run(capsys):
-    """``info --help`` and ``animate --help`` show examples, and tests/test_issue12_help_examples.py runs them
-    (it runs every help example, once per test run: they are not run a second time here)."""
-    from test_issue12_help_examples import EXAMPLES, _examples
-
-    for command in ("info", "animate"):
-        code, out, _ = run(capsys, command, "--help")
-        assert code == 0
-        assert _examples(out) == EXAMPLES[command] != []

@@ -13,10 +13,9 @@ paper's audit is one equation (the whole audit is tested in test_audit.py).
 No example may reach a network: a remote Dask scheduler (``tcp://...``) is
 named in the prose of ``sweep --help``, never as an example.
 
-This is the one test that runs the help examples (once per test run): the tests of ``simulate``, ``plot``,
-``info``, ``animate`` (tests/test_cli_torque.py, tests/test_cli_parity.py), ``validate`` and ``cases``
-(tests/test_oracle.py) check that their command's help shows the examples run here, and the files those
-examples write are checked here.
+This is the one test that runs the help examples (once per test run), and checks the files they write; the
+tests of ``simulate``, ``plot`` (tests/test_cli_torque.py), ``validate`` and ``cases`` (tests/test_oracle.py)
+check what their command's examples show.
 """
 
 import argparse

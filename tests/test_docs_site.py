@@ -47,7 +47,7 @@ def _build(tmp):
     return subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=HANG_GUARD_S), out
 
 
-# one test, one build (about 35 s of CPU; docs/conf.py's build-time shortcuts): split into several,
+# one test, one build (about 37 s of CPU with docs/conf.py's build-time shortcuts): split into several,
 # pytest-xdist would build the site once per worker
 def test_the_site_builds_clean_and_documents_every_public_name(tmp_path):
     res, out = _build(tmp_path)
